@@ -1,0 +1,164 @@
+#include "commands.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <iostream>
+#include <set>
+
+#include "core/errors.hpp"
+#include "core/registry.hpp"
+#include "models/registry.hpp"
+#include "output.hpp"
+
+namespace mpmtb {
+namespace {
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) {
+    q += c;
+    if (c == '"') q += c;
+  }
+  q += '"';
+  return q;
+}
+
+std::string number_field(const nlohmann::json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? fmt::format("{:.10g}", j[key].get<double>()) : "";
+}
+
+// DIR/runs.csv: one row per combination, the error norms as error_<name> columns.
+void write_runs_table(const std::filesystem::path& dir,
+                      const std::vector<std::pair<std::string, RunOutcome>>& runs) {
+  std::set<std::string> error_names;
+  for (const auto& [name, r] : runs) {
+    if (r.summary.contains("error")) {
+      for (const auto& [k, v] : r.summary["error"].items()) error_names.insert(k);
+    }
+  }
+  std::string out =
+      "run,transfer,kernel,dim,status,reason,particles,steps,wall_seconds,"
+      "particle_steps_per_second,drift_energy,drift_momentum,drift_angular_momentum,drift_volume";
+  for (const auto& e : error_names) {
+    out += ",error_";
+    out += e;
+  }
+  out += '\n';
+  for (const auto& [name, r] : runs) {
+    const auto& j = r.summary;
+    const nlohmann::json drift = j.value("drift", nlohmann::json::object());
+    out += fmt::format(
+        "{},{},{},{},{},{},{},{},{},{},{},{},{},{}", name, j.value("transfer", ""),
+        j.value("kernel", ""), j.contains("dim") ? std::to_string(j["dim"].get<int>()) : "",
+        r.status, csv_field(r.reason), number_field(j, "particles"), number_field(j, "steps"),
+        number_field(j, "wall_seconds"), number_field(j, "particle_steps_per_second"),
+        number_field(drift, "energy"), number_field(drift, "momentum"),
+        number_field(drift, "angular_momentum"), number_field(drift, "volume"));
+    const nlohmann::json err = j.value("error", nlohmann::json::object());
+    for (const auto& e : error_names) {
+      out += ',';
+      out += number_field(err, e.c_str());
+    }
+    out += '\n';
+  }
+  write_atomically(dir / "runs.csv", out);
+}
+
+std::vector<std::string> expand(const std::optional<std::string>& choice,
+                                const std::vector<VariantInfo>& all) {
+  if (!choice || *choice != "all") return {choice.value_or("")};
+  std::vector<std::string> names;
+  for (const auto& v : all) names.push_back(v.name);
+  return names;
+}
+
+int exit_status(const std::string& status) {
+  if (status == "ok") return kExitOk;
+  if (status == "unstable") return kExitUnstable;
+  return kExitInvalid;
+}
+
+}  // namespace
+
+int command_list(const std::string& only) {
+  auto section = [&](const char* title, const auto& items) {
+    if (!only.empty() && only != title) return;
+    if (only.empty()) fmt::print("{}:\n", title);
+    for (const auto& i : items) {
+      if (only.empty()) {
+        fmt::print("  {:<16} {}\n", i.name, i.description);
+      } else {
+        fmt::print("{}\n", i.name);
+      }
+    }
+  };
+  section("transfers", transfer_list());
+  section("kernels", kernel_list());
+  section("models", model_list());
+  std::vector<VariantInfo> scenes;
+  for (const auto& b : builtin_scenes()) {
+    const Scene s = load_scene(b.name);
+    scenes.push_back({b.name, fmt::format("{} (dims {})", s.description, fmt::join(s.dims, ","))});
+  }
+  section("scenes", scenes);
+  if (only.empty()) {
+    fmt::print("refused combinations:\n");
+    for (const auto& t : transfer_list()) {
+      for (const auto& k : kernel_list()) {
+        if (auto r = unsupported_reason(t.name, k.name); !r.empty()) fmt::print("  {}\n", r);
+      }
+    }
+  }
+  return kExitOk;
+}
+
+int command_describe(const std::string& scene, const Overrides& overrides) {
+  const Scene s = load_scene(scene, overrides);
+  std::cout << "# " << s.source << " (after overrides)\n" << s.resolved << "\n";
+  return kExitOk;
+}
+
+int command_run(const RunRequest& request) {
+  const auto transfers = expand(request.overrides.transfer, transfer_list());
+  const auto kernels = expand(request.overrides.kernel, kernel_list());
+  const bool sweep = transfers.size() > 1 || kernels.size() > 1;
+  std::vector<std::pair<std::string, RunOutcome>> runs;
+  int worst = kExitOk;
+  for (const auto& t : transfers) {
+    for (const auto& k : kernels) {
+      Overrides o = request.overrides;
+      if (!t.empty()) o.transfer = t;
+      if (!k.empty()) o.kernel = k;
+      const std::string name = fmt::format("{}-{}", t, k);
+      const std::filesystem::path dir =
+          sweep ? std::filesystem::path(request.out) / name : std::filesystem::path(request.out);
+      RunOutcome r;
+      try {
+        const Scene scene = load_scene(request.scene, o);
+        if (sweep) {
+          if (auto why = unsupported_reason(scene.transfer, scene.kernel); !why.empty()) {
+            // A refused combination is a data point of a sweep, not a failure.
+            r = write_invalid(dir, why, {{"transfer", t}, {"kernel", k}, {"dim", scene.dim}});
+            runs.emplace_back(name, r);
+            fmt::print(stderr, "{:<24} refused: {}\n", name, why);
+            continue;
+          }
+        }
+        r = run_scene(scene, dir, request.options);
+      } catch (const InputError& e) {
+        if (!sweep) throw;
+        r = write_invalid(dir, e.what(), {{"transfer", t}, {"kernel", k}});
+      }
+      fmt::print(stderr, "{:<24} {}{}{}\n", sweep ? name : request.scene, r.status,
+                 r.reason.empty() ? "" : ": ", r.reason);
+      worst = std::max(worst, exit_status(r.status));
+      runs.emplace_back(name, std::move(r));
+    }
+  }
+  if (sweep) write_runs_table(request.out, runs);
+  return worst;
+}
+
+}  // namespace mpmtb

@@ -1,0 +1,40 @@
+#include "output.hpp"
+
+#include <fmt/format.h>
+#include <unistd.h>
+
+#include <fstream>
+#include <stdexcept>
+
+namespace mpmtb {
+
+void write_atomically(const std::filesystem::path& path, const std::string& content) {
+  if (path.has_parent_path()) std::filesystem::create_directories(path.parent_path());
+  const auto tmp = path.string() + fmt::format(".tmp{}", ::getpid());
+  {
+    std::ofstream out(tmp, std::ios::binary | std::ios::trunc);
+    out << content;
+    out.flush();
+    if (!out) throw std::runtime_error("cannot write " + tmp);
+  }
+  std::filesystem::rename(tmp, path);
+}
+
+std::string CsvTable::render() const {
+  std::string s;
+  for (std::size_t i = 0; i < header.size(); ++i) {
+    if (i) s += ',';
+    s += header[i];
+  }
+  s += '\n';
+  for (const auto& row : rows) {
+    for (std::size_t i = 0; i < row.size(); ++i) {
+      if (i) s += ',';
+      s += fmt::format("{:.17g}", row[i]);
+    }
+    s += '\n';
+  }
+  return s;
+}
+
+}  // namespace mpmtb

@@ -1,0 +1,35 @@
+// Runs one scene to its end time, watching for instability, and writes
+// DIR/series.csv and DIR/summary.json (the output contract in DESIGN.md).
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <string>
+
+#include "scene.hpp"
+
+namespace mpmtb {
+
+struct RunOptions {
+  int threads = 0;  // 0: OpenMP's default
+};
+
+struct RunOutcome {
+  std::string status;  // ok | unstable | invalid
+  std::string reason;
+  nlohmann::json summary;
+};
+
+// Runs `scene` and writes its files under `out_dir`. Throws InputError when
+// the scene cannot be set up (the caller reports it as invalid).
+RunOutcome run_scene(const Scene& scene, const std::filesystem::path& out_dir,
+                     const RunOptions& options = {});
+
+// Writes a summary with status `invalid` and the reason (nothing else is run).
+RunOutcome write_invalid(const std::filesystem::path& out_dir, const std::string& reason,
+                         const nlohmann::json& context);
+
+nlohmann::json toml_to_json(const toml::node& node);
+
+}  // namespace mpmtb

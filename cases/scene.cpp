@@ -1,0 +1,363 @@
+#include "scene.hpp"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+#include <filesystem>
+#include <fstream>
+#include <sstream>
+
+#include "boundary/walls.hpp"
+#include "core/errors.hpp"
+#include "core/registry.hpp"
+#include "models/registry.hpp"
+#include "references/reference.hpp"
+#include "table_reader.hpp"
+
+namespace mpmtb {
+namespace {
+
+const std::array<std::string, 6> kFaceNames = {"x_min", "x_max", "y_min",
+                                               "y_max", "z_min", "z_max"};
+
+template <class Info>
+std::vector<std::string> names_of(const std::vector<Info>& list) {
+  std::vector<std::string> out;
+  for (const auto& i : list) out.push_back(i.name);
+  return out;
+}
+
+void read_header(TableReader& top, Scene& s) {
+  TableReader r(top.table("scene"), "scene");
+  s.name = r.string("name");
+  s.description = r.string_or("description", "");
+  s.dim = r.integer("dim", 1, 3);
+  s.dims = r.has("dims") ? r.int_list("dims", 1, 3) : std::vector<int>{s.dim};
+  r.finish();
+  if (std::find(s.dims.begin(), s.dims.end(), s.dim) == s.dims.end()) {
+    throw InputError(fmt::format("scene.dim = {} is not supported by scene '{}'; allowed: {}",
+                                 s.dim, s.name, fmt::join(s.dims, ", ")));
+  }
+}
+
+void read_domain_and_grid(TableReader& top, Scene& s) {
+  TableReader d(top.table("domain"), "domain");
+  s.domain_min = d.vec3("min");
+  s.domain_max = d.vec3("max");
+  d.finish();
+  for (int a = 0; a < s.dim; ++a) {
+    if (!(s.domain_max[a] > s.domain_min[a])) {
+      throw InputError(fmt::format("domain.max[{}] = {} must exceed domain.min[{}] = {}", a,
+                                   s.domain_max[a], a, s.domain_min[a]));
+    }
+  }
+  TableReader g(top.table("grid"), "grid");
+  s.cells = g.integer("cells", 1, 1 << 20);
+  s.length = g.number_or("length", s.domain_max[0] - s.domain_min[0], Range::positive());
+  s.ppc = g.integer_or("ppc", 2, 1, 16);
+  g.finish();
+}
+
+void read_method(TableReader& top, Scene& s) {
+  TableReader m(top.table("method"), "method");
+  s.transfer = m.choice("transfer", names_of(transfer_list()));
+  s.kernel = m.choice("kernel", names_of(kernel_list()));
+  m.finish();
+  // A table named after a transfer holds that transfer's parameters ([flip] alpha = ...).
+  for (const auto& t : transfer_list()) {
+    const toml::table* params = top.table_or_null(t.name);
+    if (t.name == s.transfer) {
+      s.transfer_params = Parameters(t.name);
+      if (params) s.transfer_params = TableReader(*params, t.name).numbers_as_parameters({});
+    }
+  }
+}
+
+void read_time(TableReader& top, Scene& s) {
+  TableReader t(top.table("time"), "time");
+  s.t_end = t.number("t_end", Range::positive());
+  if (t.has("dt") == t.has("cfl")) {
+    t.number_or("dt", 0, Range::any());
+    t.number_or("cfl", 0, Range::any());
+    throw InputError("time: give exactly one of 'dt' (fixed step) or 'cfl' (adaptive step)");
+  }
+  if (t.has("dt")) s.dt = t.number("dt", Range::positive());
+  if (t.has("cfl")) s.cfl = t.number("cfl", Range::positive());
+  s.output_interval = t.number_or("output_interval", s.t_end / 100, Range::positive());
+  t.finish();
+}
+
+void read_physics_and_walls(TableReader& top, Scene& s) {
+  if (const toml::table* p = top.table_or_null("physics")) {
+    TableReader r(*p, "physics");
+    s.gravity = r.vec3_or("gravity", Vec3::Zero());
+    r.finish();
+  }
+  std::string fallback = "free";
+  s.walls.fill(fallback);
+  if (const toml::table* b = top.table_or_null("boundary")) {
+    TableReader r(*b, "boundary");
+    fallback = r.has("default") ? r.choice("default", wall_names()) : fallback;
+    for (std::size_t f = 0; f < kFaceNames.size(); ++f) {
+      s.walls[f] = r.has(kFaceNames[f]) ? r.choice(kFaceNames[f], wall_names()) : fallback;
+    }
+    r.finish();
+  }
+  if (const toml::table* c = top.table_or_null("checks")) {
+    TableReader r(*c, "checks");
+    s.energy_limit = r.number_or("energy_limit", s.energy_limit, Range::open(1, 1e300));
+    r.finish();
+  }
+}
+
+void read_materials(TableReader& top, Scene& s) {
+  const toml::table& mats = top.table("materials");
+  if (mats.empty()) throw InputError("materials: at least one material is required");
+  for (const auto& [k, v] : mats) {
+    const std::string name(k.str());
+    const toml::table* t = v.as_table();
+    if (!t) throw InputError(fmt::format("materials.{}: expected a table", name));
+    TableReader r(*t, "materials." + name);
+    MaterialSpec m;
+    m.name = name;
+    m.model = r.choice("model", names_of(model_list()));
+    m.params = r.numbers_as_parameters({"model"});
+    r.finish();
+    Parameters probe = m.params;  // validates the parameters now, by the model itself
+    make_model<1>(m.model, probe);
+    s.materials.push_back(std::move(m));
+  }
+}
+
+int material_index(const Scene& s, const std::string& name, const std::string& field) {
+  std::vector<std::string> names;
+  for (std::size_t i = 0; i < s.materials.size(); ++i) {
+    if (s.materials[i].name == name) return static_cast<int>(i);
+    names.push_back(s.materials[i].name);
+  }
+  throw InputError(
+      fmt::format("{}: unknown material '{}'; defined: {}", field, name, fmt::join(names, ", ")));
+}
+
+void read_bodies(TableReader& top, Scene& s) {
+  const auto bodies = top.table_array("bodies");
+  for (std::size_t i = 0; i < bodies.size(); ++i) {
+    const std::string path = fmt::format("bodies[{}]", i);
+    TableReader r(*bodies[i], path);
+    BodySpec b;
+    b.shape = r.choice("shape", {"box", "sphere", "ring"});
+    if (b.shape == "box") {
+      b.min = r.vec3("min");
+      b.max = r.vec3("max");
+      for (int a = 0; a < s.dim; ++a) {
+        if (!(b.max[a] > b.min[a])) {
+          throw InputError(fmt::format("{}.max[{}] must exceed {}.min[{}]", path, a, path, a));
+        }
+      }
+    } else {
+      b.center = r.vec3("center");
+      b.radius = r.number("radius", Range::positive());
+      if (b.shape == "ring") {
+        b.inner_radius = r.number("inner_radius", Range::half_open(0, b.radius));
+      }
+    }
+    b.material = material_index(s, r.string("material"), path + ".material");
+    b.velocity = r.vec3_or("velocity", Vec3::Zero());
+    b.angular_velocity = r.vec3_or("angular_velocity", Vec3::Zero());
+    r.finish();
+    Vec3 lo, hi;
+    b.bounds(lo, hi);
+    for (int a = 0; a < s.dim; ++a) {
+      if (lo[a] < s.domain_min[a] || hi[a] > s.domain_max[a]) {
+        throw InputError(
+            fmt::format("{}: extends outside the domain along axis {} ([{}, {}] vs "
+                        "domain [{}, {}])",
+                        path, a, lo[a], hi[a], s.domain_min[a], s.domain_max[a]));
+      }
+    }
+    s.bodies.push_back(b);
+  }
+  if (top.has("pins")) {
+    const auto pins = top.table_array("pins");
+    for (std::size_t i = 0; i < pins.size(); ++i) {
+      TableReader r(*pins[i], fmt::format("pins[{}]", i));
+      s.pins.push_back({r.vec3("min"), r.vec3("max")});
+      r.finish();
+    }
+  }
+}
+
+void read_reference(TableReader& top, Scene& s) {
+  const toml::table* t = top.table_or_null("reference");
+  if (!t) return;
+  TableReader r(*t, "reference");
+  s.reference = r.choice("kind", reference_kinds());
+  s.reference_params = r.numbers_as_parameters({"kind"});
+  r.finish();
+}
+
+}  // namespace
+
+Vec3 BodySpec::rotation_center() const {
+  return shape == "box" ? Vec3((min + max) / 2) : center;
+}
+
+bool BodySpec::contains(const Vec3& x, int dim) const {
+  if (shape == "box") {
+    for (int a = 0; a < dim; ++a) {
+      if (x[a] < min[a] || x[a] >= max[a]) return false;
+    }
+    return true;
+  }
+  const Real r = (x - center).head(dim).norm();
+  return r < radius && r >= inner_radius;
+}
+
+void BodySpec::bounds(Vec3& lo, Vec3& hi) const {
+  if (shape == "box") {
+    lo = min;
+    hi = max;
+  } else {
+    lo = center - Vec3::Constant(radius);
+    hi = center + Vec3::Constant(radius);
+  }
+}
+
+toml::table parse_scene_text(const std::string& text, const std::string& source) {
+  try {
+    return toml::parse(text, source);
+  } catch (const toml::parse_error& e) {
+    throw InputError(fmt::format("{}:{}:{}: malformed TOML: {}", source, e.source().begin.line,
+                                 e.source().begin.column, e.description()));
+  }
+}
+
+void apply_set(toml::table& tree, const std::string& assignment) {
+  const auto eq = assignment.find('=');
+  if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size()) {
+    throw InputError(fmt::format("--set '{}': expected key.path=value", assignment));
+  }
+  const std::string path = assignment.substr(0, eq), text = assignment.substr(eq + 1);
+  // The value is TOML (number, bool, array, quoted string); a bare word is a string.
+  toml::table parsed;
+  try {
+    parsed = toml::parse("v = " + text);
+  } catch (const toml::parse_error&) {
+    parsed = toml::table{{"v", text}};
+  }
+  std::vector<std::string> keys;
+  std::stringstream ss(path);
+  for (std::string k; std::getline(ss, k, '.');) {
+    if (k.empty()) throw InputError(fmt::format("--set '{}': empty key in path", assignment));
+    keys.push_back(k);
+  }
+  toml::node* node = &tree;
+  for (std::size_t i = 0; i + 1 < keys.size(); ++i) {
+    if (auto* t = node->as_table()) {
+      if (!t->contains(keys[i])) t->insert(keys[i], toml::table{});
+      node = t->get(keys[i]);
+    } else if (auto* a = node->as_array()) {
+      std::size_t idx = 0;
+      try {
+        idx = std::stoul(keys[i]);
+      } catch (...) {
+        idx = a->size();
+      }
+      if (idx >= a->size()) {
+        throw InputError(fmt::format("--set '{}': '{}' is not an index of an array of {} entries",
+                                     assignment, keys[i], a->size()));
+      }
+      node = a->get(idx);
+    } else {
+      throw InputError(fmt::format("--set '{}': '{}' is not a table", assignment, keys[i]));
+    }
+  }
+  auto* target = node->as_table();
+  if (!target)
+    throw InputError(fmt::format("--set '{}': cannot assign inside a value", assignment));
+  target->insert_or_assign(keys.back(), *parsed.get("v"));
+}
+
+void apply_overrides(toml::table& tree, const Overrides& o) {
+  auto set = [&](const std::string& key, auto value) {
+    apply_set(tree, key + "=" + fmt::format("{}", value));
+  };
+  auto set_string = [&](const std::string& key, const std::string& value) {
+    apply_set(tree, key + "=\"" + value + "\"");
+  };
+  if (o.dim) set("scene.dim", *o.dim);
+  if (o.cells) set("grid.cells", *o.cells);
+  if (o.ppc) set("grid.ppc", *o.ppc);
+  if (o.transfer) set_string("method.transfer", *o.transfer);
+  if (o.kernel) set_string("method.kernel", *o.kernel);
+  if (o.t_end) set("time.t_end", fmt::format("{:.17g}", *o.t_end));
+  if (o.cfl || o.dt) {
+    if (auto* t = tree["time"].as_table()) {
+      t->erase("cfl");
+      t->erase("dt");
+    }
+    if (o.cfl) set("time.cfl", fmt::format("{:.17g}", *o.cfl));
+    if (o.dt) set("time.dt", fmt::format("{:.17g}", *o.dt));
+  }
+  if (o.model) {
+    if (auto* mats = tree["materials"].as_table()) {
+      for (auto& [k, v] : *mats) {
+        if (auto* t = v.as_table()) t->insert_or_assign("model", *o.model);
+      }
+    }
+  }
+  for (const auto& a : o.set) apply_set(tree, a);
+}
+
+Scene read_scene(const toml::table& tree, const std::string& source) {
+  try {
+    Scene s;
+    s.source = source;
+    s.resolved = tree;
+    TableReader top(tree, "");
+    read_header(top, s);
+    read_domain_and_grid(top, s);
+    read_method(top, s);
+    read_time(top, s);
+    read_physics_and_walls(top, s);
+    read_materials(top, s);
+    read_bodies(top, s);
+    read_reference(top, s);
+    top.finish();
+    return s;
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", source, e.what()));
+  }
+}
+
+Scene load_scene(const std::string& name_or_path, const Overrides& o) {
+  std::string text, source;
+  for (const auto& b : builtin_scenes()) {
+    if (b.name == name_or_path) {
+      text = b.text;
+      source = "scene '" + b.name + "'";
+    }
+  }
+  if (source.empty()) {
+    std::ifstream in(name_or_path);
+    if (!in) {
+      std::vector<std::string> names;
+      for (const auto& b : builtin_scenes()) names.push_back(b.name);
+      throw InputError(fmt::format("scene '{}': no such file or built-in scene; built-in: {}",
+                                   name_or_path, fmt::join(names, ", ")));
+    }
+    std::stringstream buf;
+    buf << in.rdbuf();
+    text = buf.str();
+    source = name_or_path;
+  }
+  toml::table tree = parse_scene_text(text, source);
+  try {
+    apply_overrides(tree, o);
+  } catch (const InputError& e) {
+    throw InputError(fmt::format("{}: {}", source, e.what()));
+  }
+  return read_scene(tree, source);
+}
+
+}  // namespace mpmtb

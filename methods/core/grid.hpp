@@ -1,0 +1,96 @@
+// Uniform background grid: geometry and the nodal arrays of one step.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "types.hpp"
+
+namespace mpmtb {
+
+// Geometry of a uniform grid over the box [lo, hi] with `cells` cells per axis
+// and `pad` ghost nodes beyond each face, so that every kernel stencil of a
+// particle inside the box lies on the grid.
+template <int Dim>
+struct GridGeometry {
+  static constexpr int pad = 2;  // enough for the cubic B-spline (4 nodes per axis)
+
+  Vec<Dim> lo = Vec<Dim>::Zero();
+  Real dx = 1;
+  std::array<int, Dim> cells{};
+
+  GridGeometry() = default;
+  GridGeometry(const Vec<Dim>& lower, Real spacing, const std::array<int, Dim>& n)
+      : lo(lower), dx(spacing), cells(n) {
+    long stride = 1;
+    for (int a = Dim - 1; a >= 0; --a) {
+      strides_[a] = stride;
+      stride *= nodes(a);
+    }
+    node_count_ = stride;
+  }
+
+  Vec<Dim> hi() const {
+    Vec<Dim> h;
+    for (int a = 0; a < Dim; ++a) h[a] = lo[a] + cells[a] * dx;
+    return h;
+  }
+  int nodes(int axis) const { return cells[axis] + 1 + 2 * pad; }
+  long node_count() const { return node_count_; }
+  const std::array<long, Dim>& strides() const { return strides_; }
+
+  // Node coordinate along one axis for a padded node index.
+  Real coordinate(int axis, int i) const { return lo[axis] + (i - pad) * dx; }
+
+  std::array<int, Dim> multi_index(long node) const {
+    std::array<int, Dim> idx{};
+    for (int a = 0; a < Dim; ++a) {
+      idx[a] = static_cast<int>(node / strides_[a]);
+      node %= strides_[a];
+    }
+    return idx;
+  }
+  Vec<Dim> position(long node) const {
+    const auto idx = multi_index(node);
+    Vec<Dim> x;
+    for (int a = 0; a < Dim; ++a) x[a] = coordinate(a, idx[a]);
+    return x;
+  }
+  // True when the point lies inside the box [lo, hi] (closed).
+  bool contains(const Vec<Dim>& x) const {
+    for (int a = 0; a < Dim; ++a) {
+      if (!(x[a] >= lo[a] && x[a] <= lo[a] + cells[a] * dx)) return false;
+    }
+    return true;
+  }
+
+ private:
+  std::array<long, Dim> strides_{};
+  long node_count_ = 0;
+};
+
+// Nodal fields. p_i is the momentum transferred from the particles, f_i the
+// internal force; the grid update turns them into v_i.
+template <int Dim>
+struct Grid {
+  GridGeometry<Dim> geo;
+  std::vector<Real> m;               // m_i
+  std::vector<Vec<Dim>> p;           // p_i  momentum (before forces)
+  std::vector<Vec<Dim>> f;           // f_i  internal force
+  std::vector<Vec<Dim>> v;           // v_i  velocity after the grid update
+  std::vector<Vec<Dim>> v_old;       // v_i before forces (kept for FLIP-like transfers)
+  std::vector<std::uint8_t> pinned;  // nodes held at rest by pinned particles
+
+  explicit Grid(const GridGeometry<Dim>& g = {}) : geo(g) {
+    const auto n = static_cast<std::size_t>(g.node_count());
+    m.assign(n, 0);
+    p.assign(n, Vec<Dim>::Zero());
+    f.assign(n, Vec<Dim>::Zero());
+    v.assign(n, Vec<Dim>::Zero());
+    v_old.assign(n, Vec<Dim>::Zero());
+    pinned.assign(n, 0);
+  }
+  std::size_t size() const { return m.size(); }
+};
+
+}  // namespace mpmtb

@@ -1,0 +1,33 @@
+// Names to compiled combinations. The lists live in transfers/all.hpp,
+// kernels/all.hpp and models/registry.cpp; this resolves a name once, at set-up.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <string_view>
+#include <vector>
+
+#include "core/parameters.hpp"
+#include "core/stepper.hpp"
+
+namespace mpmtb {
+
+struct VariantInfo {
+  std::string name;
+  std::string description;
+};
+
+std::vector<VariantInfo> transfer_list();
+std::vector<VariantInfo> kernel_list();
+
+// Empty when the combination runs; otherwise the reason it is refused.
+// Unknown names throw InputError listing the valid ones.
+std::string unsupported_reason(std::string_view transfer, std::string_view kernel);
+
+// The compiled solver for (Dim, kernel, transfer). Throws InputError for
+// unknown names (listing the valid ones) and refused combinations.
+template <int Dim>
+std::unique_ptr<Stepper<Dim>> make_stepper(std::string_view transfer, std::string_view kernel,
+                                           Parameters& transfer_params);
+
+}  // namespace mpmtb

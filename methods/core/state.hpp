@@ -1,0 +1,42 @@
+// Everything a step reads and writes: particles, grid, materials, boundary.
+#pragma once
+
+#include <functional>
+#include <memory>
+#include <vector>
+
+#include "boundary/walls.hpp"
+#include "core/grid.hpp"
+#include "core/particles.hpp"
+#include "models/model.hpp"
+
+namespace mpmtb {
+
+template <int Dim>
+struct State {
+  Particles<Dim> particles;
+  Grid<Dim> grid;
+  std::vector<std::unique_ptr<ConstitutiveModel<Dim>>> materials;
+  std::vector<std::vector<int>> material_particles;  // particle ids of each material
+  Walls<Dim> walls;
+  Vec<Dim> gravity = Vec<Dim>::Zero();
+  // Optional body force per unit mass b(x_p, p, t) (manufactured solutions).
+  std::function<Vec<Dim>(const Particles<Dim>&, int p, Real t)> body_force;
+  Real time = 0;
+  long step = 0;
+
+  // Groups particle ids by material; call after the particles are seeded.
+  void index_materials() {
+    material_particles.assign(materials.size(), {});
+    for (std::size_t p = 0; p < particles.size(); ++p) {
+      material_particles[particles.material[p]].push_back(static_cast<int>(p));
+    }
+  }
+  Real max_wave_speed() const {
+    Real c = 0;
+    for (const auto& m : materials) c = std::max(c, m->wave_speed());
+    return c;
+  }
+};
+
+}  // namespace mpmtb

@@ -1,0 +1,73 @@
+// The constitutive-model interface. A model is chosen per material at run time
+// and called once per material per stage (a batch over its particles), never
+// inside the particle-node loops. Concrete models derive from ModelBase, which
+// writes the batch loops once over the model's per-particle formulas.
+#pragma once
+
+#include <memory>
+#include <span>
+#include <string_view>
+#include <vector>
+
+#include "core/particles.hpp"
+#include "core/types.hpp"
+
+namespace mpmtb {
+
+template <int Dim>
+class ConstitutiveModel {
+ public:
+  virtual ~ConstitutiveModel() = default;
+
+  virtual std::string_view name() const = 0;
+  virtual Real density() const = 0;
+  // P-wave speed sqrt((lambda + 2 mu) / rho): sets the CFL time step.
+  virtual Real wave_speed() const = 0;
+  // Internal variables per particle (plastic J, damage, ...); 0 for pure elasticity.
+  virtual int state_size() const { return 0; }
+  virtual void initial_state(Real* /*q*/) const {}
+
+  // Per-particle formulas, for tests and diagnostics.
+  virtual Real energy_density(const Mat<Dim>& F, const Real* q) const = 0;   // psi(F)
+  virtual Mat<Dim> first_piola(const Mat<Dim>& F, const Real* q) const = 0;  // P = dpsi/dF
+
+  // Batches over the particles `ids` of this material.
+  // tauV[p] = V0_p * tau(F_p), tau = P F^T the Kirchhoff stress.
+  virtual void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
+                                      std::vector<Mat<Dim>>& tauV) const = 0;
+  // sum_p V0_p psi(F_p), summed in particle order (deterministic).
+  virtual Real strain_energy(const Particles<Dim>& particles, std::span<const int> ids) const = 0;
+  // Plastic or damage return map after F_p is updated; no-op for elasticity.
+  virtual void return_map(Particles<Dim>& /*particles*/, std::span<const int> /*ids*/,
+                          Real /*dt*/) const {}
+};
+
+// Writes the batch loops once. Derived provides psi(F, q), P(F, q), tau(F, q).
+template <int Dim, class Derived>
+class ModelBase : public ConstitutiveModel<Dim> {
+ public:
+  Real energy_density(const Mat<Dim>& F, const Real* q) const override { return self().psi(F, q); }
+  Mat<Dim> first_piola(const Mat<Dim>& F, const Real* q) const override { return self().P(F, q); }
+  void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
+                              std::vector<Mat<Dim>>& tauV) const override {
+    const long n = static_cast<long>(ids.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long i = 0; i < n; ++i) {
+      const int p = ids[i];
+      tauV[p] = particles.V0[p] * self().tau(particles.F[p], particles.state_of(p));
+    }
+  }
+  Real strain_energy(const Particles<Dim>& particles, std::span<const int> ids) const override {
+    Real sum = 0;
+    for (const int p : ids)
+      sum += particles.V0[p] * self().psi(particles.F[p], particles.state_of(p));
+    return sum;
+  }
+
+ private:
+  const Derived& self() const {
+    return static_cast<const Derived&>(*this);
+  }
+};
+
+}  // namespace mpmtb

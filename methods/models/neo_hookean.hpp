@@ -1,0 +1,48 @@
+// Compressible neo-Hookean elasticity (Bonet & Wood 2008, eq. 6.28; as used in
+// Jiang et al. 2016, "The Material Point Method for Simulating Continuum
+// Materials", eq. 48):
+//   psi = mu/2 (tr(F^T F) - d) - mu ln J + lambda/2 (ln J)^2
+//   P   = mu (F - F^-T) + lambda ln J F^-T
+//   tau = P F^T = mu (F F^T - I) + lambda ln J I
+// Undefined for J <= 0: the step loop reports such a state as unstable.
+#pragma once
+
+#include <cmath>
+
+#include "models/lame.hpp"
+#include "models/model.hpp"
+
+namespace mpmtb {
+
+template <int Dim>
+class NeoHookean final : public ModelBase<Dim, NeoHookean<Dim>> {
+ public:
+  static constexpr std::string_view model_name = "neo-hookean";
+
+  explicit NeoHookean(Parameters& params) : c_(ElasticConstants::read(params)) {}
+
+  std::string_view name() const override { return model_name; }
+  Real density() const override { return c_.density; }
+  Real wave_speed() const override { return c_.wave_speed(); }
+
+  Real psi(const Mat<Dim>& F, const Real*) const {
+    const Real logJ = std::log(F.determinant());
+    return Real(0.5) * c_.mu * ((F.transpose() * F).trace() - Dim) - c_.mu * logJ +
+           Real(0.5) * c_.lambda * logJ * logJ;
+  }
+  Mat<Dim> P(const Mat<Dim>& F, const Real*) const {
+    const Mat<Dim> F_invT = F.inverse().transpose();
+    const Real logJ = std::log(F.determinant());
+    return c_.mu * (F - F_invT) + c_.lambda * logJ * F_invT;
+  }
+  Mat<Dim> tau(const Mat<Dim>& F, const Real*) const {
+    const Real logJ = std::log(F.determinant());
+    return c_.mu * (F * F.transpose() - Mat<Dim>::Identity()) +
+           c_.lambda * logJ * Mat<Dim>::Identity();
+  }
+
+ private:
+  ElasticConstants c_;
+};
+
+}  // namespace mpmtb

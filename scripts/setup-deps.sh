@@ -1,0 +1,20 @@
+#!/usr/bin/env bash
+# Installs the Debian packages mpmtb needs, if any is missing (Debian 12).
+# Runs apt-get as root, or through sudo; does nothing when all are present.
+set -euo pipefail
+packages=(g++ make cmake libeigen3-dev libfmt-dev libcli11-dev libtomlplusplus-dev
+          nlohmann-json3-dev libgtest-dev libbenchmark-dev python3-matplotlib python3-numpy)
+missing=()
+for p in "${packages[@]}"; do
+  dpkg-query -W -f='${Status}' "$p" 2>/dev/null | grep -q "install ok installed" || missing+=("$p")
+done
+[ ${#missing[@]} -eq 0 ] && exit 0
+echo "mpmtb: installing missing Debian packages: ${missing[*]}" >&2
+sudo=""
+if [ "$(id -u)" -ne 0 ]; then
+  command -v sudo >/dev/null || { echo "mpmtb: run as root or install: ${missing[*]}" >&2; exit 1; }
+  sudo="sudo"
+fi
+export DEBIAN_FRONTEND=noninteractive
+$sudo apt-get update -qq
+$sudo apt-get install -y -qq --no-install-recommends "${missing[@]}"

@@ -1,0 +1,9 @@
+#!/usr/bin/env bash
+# Installs what is missing, builds, and runs the default test set (the unit,
+# verification and end-to-end labels). Long sweeps carry other labels and run
+# from scripts/suite.sh.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+bash scripts/build.sh
+cd build
+ctest -L 'unit|verification|e2e' --output-on-failure -j "$(nproc)"
