@@ -136,6 +136,32 @@ def plot_energy(sweep, runs):
     return ["energy.png"]
 
 
+def plot_angular_momentum(sweep, runs):
+    """|L - L0| / |L0| over time, linear and logarithmic (round-off shows)."""
+    def vector(run):
+        return np.stack([run.series[c] for c in ("Lx", "Ly", "Lz")], axis=1)
+    starts = [np.linalg.norm(vector(run)[0]) for run in runs]
+    scale = max(starts) if starts else 0.0
+    if not np.isfinite(scale) or scale <= 0:
+        return []
+    spinning = [(run, s) for run, s in zip(runs, starts) if s > 1e-9 * scale]
+    if not spinning:
+        return []
+    fig, axes = mp.new_figure(2, f"{sweep.title}: angular momentum")
+    for run, start in spinning:
+        L = vector(run)
+        signed = (np.linalg.norm(L, axis=1) - start) / start
+        change = np.linalg.norm(L - L[0], axis=1) / start
+        run.plot(axes[0], signed)
+        run.plot(axes[1], np.maximum(change, 1e-17))
+    axes[0].set_ylabel("$(|L| - |L_0|)/|L_0|$")
+    axes[1].set_ylabel("$|L - L_0|/|L_0|$")
+    axes[1].set_yscale("log")
+    mp.legend_outside(fig, axes[0])
+    mp.save_figure(fig, os.path.join(sweep.dir, "angular_momentum.png"))
+    return ["angular_momentum.png"]
+
+
 def plot_errors(sweep, runs):
     """Grouped bars: one group per error_* column, one bar per run."""
     values = np.array([[run.value(c) for c in sweep.error_columns]
@@ -198,6 +224,7 @@ def plot_sweep(sweep):
     plotted = sweep.plotted_runs()
     if plotted:
         sweep.figures += plot_energy(sweep, plotted)
+        sweep.figures += plot_angular_momentum(sweep, plotted)
         common = set.intersection(*(set(r.series) for r in plotted))
         for plotter in mp.plotters_for(common):
             sweep.figures += plotter(sweep.title, plotted, sweep.dir)

@@ -1,16 +1,22 @@
 #!/usr/bin/env bash
 # The main job: installs what is missing, builds, runs the comparison suite on
 # its quick default and regenerates the figures and results/README.md.
-# Now: the vibrating bar for every transfer x kernel in 1D, 2D and 3D.
+# Every transfer x kernel on the vibrating bar (1D, 2D, 3D), the colliding
+# disks (2D) and spheres (3D) and the free rotating body (2D, 3D).
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
 mpmtb=build/cases/mpmtb
-for dim in 1 2 3; do
-  rm -rf "results/bar/${dim}d"
-  # Refused combinations are recorded as `invalid`; an unstable run exits 3
-  # and is recorded too, so only errors of the program stop the suite.
-  "$mpmtb" run bar --dim "$dim" --transfer all --kernel all --out "results/bar/${dim}d" || [ $? -eq 3 ]
-done
+sweep() {  # scene dim
+  rm -rf "results/$1/$2d"
+  # Refused combinations are recorded as `invalid` and an unstable run (exit 3)
+  # as `unstable`: both are data; only a failure of the program stops the suite.
+  "$mpmtb" run "$1" --dim "$2" --transfer all --kernel all --out "results/$1/$2d" || [ $? -eq 3 ]
+}
+for dim in 1 2 3; do sweep bar "$dim"; done
+sweep disks 2
+sweep spheres 3
+sweep rotating 2
+sweep rotating 3
 /usr/bin/python3 analysis/plot_all.py --results results
 echo "mpmtb: results in results/README.md"

@@ -13,5 +13,7 @@ figures=$(grep -o '([^)]*\.png)' "$work/README.md" | tr -d '()')
 for f in $figures; do
   head -c 8 "$work/$f" | od -An -tx1 | grep -q "89 50 4e 47" || { echo "not a PNG: $f"; exit 1; }
 done
-grep -q "mls-linear" "$work/README.md" || { echo "refused combination missing from the index"; exit 1; }
+for run in $("$mpmtb" list transfers); do
+  grep -q "$run-linear" "$work/README.md" || { echo "$run-linear missing from the index"; exit 1; }
+done
 echo "e2e: $(echo $figures | wc -w) figures"

@@ -40,18 +40,22 @@ Diagnostics measure(const State<Dim>& s, const Stepper<Dim>& stepper) {
 }
 
 template <int Dim>
-void grid_totals(const Grid<Dim>& g, Real& mass, Vec3& momentum) {
-  mass = 0;
-  momentum.setZero();
+GridDiagnostics measure_grid(const Grid<Dim>& g) {
+  GridDiagnostics d;
   for (std::size_t i = 0; i < g.size(); ++i) {
-    mass += g.m[i];
-    momentum += to3<Dim>(g.p[i]);
+    if (g.m[i] <= 0) continue;
+    const Vec3 p = to3<Dim>(g.p[i]);
+    d.mass += g.m[i];
+    d.momentum += p;
+    d.angular_momentum += to3<Dim>(g.geo.position(static_cast<long>(i))).cross(p);
+    d.kinetic += Real(0.5) * g.m[i] * g.v[i].squaredNorm();
   }
+  return d;
 }
 
 #define MPMTB_INSTANTIATE(D)                                           \
   template Diagnostics measure<D>(const State<D>&, const Stepper<D>&); \
-  template void grid_totals<D>(const Grid<D>&, Real&, Vec3&);
+  template GridDiagnostics measure_grid<D>(const Grid<D>&);
 MPMTB_INSTANTIATE(1)
 MPMTB_INSTANTIATE(2)
 MPMTB_INSTANTIATE(3)

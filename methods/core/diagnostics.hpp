@@ -23,8 +23,16 @@ struct Diagnostics {
 template <int Dim>
 Diagnostics measure(const State<Dim>& s, const Stepper<Dim>& stepper);
 
-// Grid-side mass and momentum after P2G: sum_i m_i and sum_i p_i.
+// The same quantities measured on the grid, to check each transfer direction:
+// after P2G, mass sum m_i, momentum sum p_i and angular momentum sum x_i x p_i
+// (before forces); after the grid update, kinetic energy sum m_i |v_i|^2 / 2.
+struct GridDiagnostics {
+  Real mass = 0;
+  Vec3 momentum = Vec3::Zero();
+  Vec3 angular_momentum = Vec3::Zero();
+  Real kinetic = 0;
+};
 template <int Dim>
-void grid_totals(const Grid<Dim>& g, Real& mass, Vec3& momentum);
+GridDiagnostics measure_grid(const Grid<Dim>& g);
 
 }  // namespace mpmtb

@@ -42,7 +42,10 @@ void require_known(std::string_view transfer, std::string_view kernel) {
 }  // namespace
 
 std::vector<VariantInfo> transfer_list() {
-  return infos<AllTransfers>();
+  std::vector<VariantInfo> out = infos<AllTransfers>();
+  std::size_t i = 0;
+  AllTransfers::for_each([&]<class T>() { out[i++].affine = T::affine_momentum; });
+  return out;
 }
 std::vector<VariantInfo> kernel_list() {
   return infos<AllKernels>();

@@ -15,6 +15,7 @@ namespace mpmtb {
 struct VariantInfo {
   std::string name;
   std::string description;
+  bool affine = false;  // transfers: P2G carries C_p, so L includes the affine part
 };
 
 std::vector<VariantInfo> transfer_list();

@@ -4,10 +4,13 @@
 #pragma once
 
 #include "core/type_list.hpp"
+#include "transfers/apic.hpp"
+#include "transfers/flip.hpp"
 #include "transfers/mls.hpp"
+#include "transfers/pic.hpp"
 
 namespace mpmtb {
 
-using AllTransfers = TypeList<MlsTransfer>;
+using AllTransfers = TypeList<PicTransfer, FlipTransfer, ApicTransfer, MlsTransfer>;
 
 }  // namespace mpmtb

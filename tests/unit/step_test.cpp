@@ -6,32 +6,13 @@
 #include "core/diagnostics.hpp"
 #include "core/registry.hpp"
 #include "setup.hpp"
+#include "support/combinations.hpp"
 #include "support/scenes.hpp"
 
 namespace mpmtb {
 namespace {
 
-struct Combination {
-  int dim;
-  std::string transfer, kernel;
-};
-
-// Every compiled combination: new transfers and kernels join automatically.
-std::vector<Combination> all_combinations() {
-  std::vector<Combination> out;
-  for (int dim = 1; dim <= 3; ++dim) {
-    for (const auto& t : transfer_list()) {
-      for (const auto& k : kernel_list()) {
-        if (unsupported_reason(t.name, k.name).empty()) out.push_back({dim, t.name, k.name});
-      }
-    }
-  }
-  return out;
-}
-
-std::string name_of(const ::testing::TestParamInfo<Combination>& info) {
-  return std::to_string(info.param.dim) + "d_" + info.param.transfer + "_" + info.param.kernel;
-}
+using testing::Combination;
 
 class StepTest : public ::testing::TestWithParam<Combination> {
  protected:
@@ -48,16 +29,7 @@ class StepTest : public ::testing::TestWithParam<Combination> {
   }
   template <class F>
   void for_dim(F&& f) {
-    switch (GetParam().dim) {
-      case 1:
-        f.template operator()<1>();
-        break;
-      case 2:
-        f.template operator()<2>();
-        break;
-      default:
-        f.template operator()<3>();
-    }
+    testing::with_dim(GetParam().dim, f);
   }
 };
 
@@ -66,13 +38,11 @@ TEST_P(StepTest, P2GConservesMass) {
   for_dim([&]<int Dim>() {
     run<Dim>([](State<Dim>& s, Stepper<Dim>& st, const Scene&) {
       st.particles_to_grid(s, 1e-3);
-      Real grid_mass;
-      Vec3 grid_p;
-      grid_totals(s.grid, grid_mass, grid_p);
+      const GridDiagnostics g = measure_grid(s.grid);
       const Diagnostics d = measure(s, st);
-      EXPECT_NEAR(grid_mass, d.mass, 1e-14 * d.mass);
+      EXPECT_NEAR(g.mass, d.mass, 1e-14 * d.mass);
       // Zero first moment: the affine part adds no net momentum.
-      EXPECT_LE((grid_p - d.momentum).norm(), 1e-12 * d.momentum.norm());
+      EXPECT_LE((g.momentum - d.momentum).norm(), 1e-12 * d.momentum.norm());
     });
   });
 }
@@ -150,8 +120,9 @@ TEST_P(StepTest, ThreadCountDoesNotChangeTheResult) {
   });
 }
 
-INSTANTIATE_TEST_SUITE_P(AllCombinations, StepTest, ::testing::ValuesIn(all_combinations()),
-                         name_of);
+INSTANTIATE_TEST_SUITE_P(AllCombinations, StepTest,
+                         ::testing::ValuesIn(testing::all_combinations()),
+                         testing::combination_name);
 
 // Affine transfers keep angular momentum, the affine part included, to round-off.
 TEST(AffineTransfer, FreeFlightConservesAngularMomentum) {

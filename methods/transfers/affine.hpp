@@ -1,0 +1,37 @@
+// Moments shared by the affine transfers (APIC, MLS-MPM).
+//
+// B_p = sum_i w_ip v_i (x_i - x_p)^T and C_p = B_p D_p^-1 (Jiang et al. 2015,
+// eq. 8-10), with D_p = inertia dx^2 I for a B-spline. For the linear hat D_p is
+// singular at nodes, but per axis grad w_ip D_p = w_ip (x_i - x_p) holds exactly,
+// so C_p = sum_i v_i grad w_ip^T is the same matrix wherever D_p is invertible
+// and extends it continuously to the nodes. The same identity turns MLS-MPM's
+// force direction D_p^-1 (x_i - x_p) w_ip into grad w_ip for the hat.
+#pragma once
+
+#include "core/types.hpp"
+
+namespace mpmtb {
+
+template <int Dim, class Kernel>
+class AffineMoments {
+  using V = Vec<Dim>;
+  using M = Mat<Dim>;
+
+ public:
+  explicit AffineMoments(Real dx)
+      : D_inv_(Kernel::constant_inertia ? 1 / (Kernel::inertia * dx * dx) : 0) {}
+
+  // The vector q_ip with C_p = sum_i v_i q_ip^T: D^-1 w (x_i - x_p), or grad w.
+  V weight_moment(Real w, const V& grad, const V& d) const {
+    if constexpr (Kernel::constant_inertia) {
+      return (w * D_inv_) * d;
+    } else {
+      return grad;
+    }
+  }
+
+ private:
+  Real D_inv_;
+};
+
+}  // namespace mpmtb

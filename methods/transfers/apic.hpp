@@ -1,0 +1,78 @@
+// APIC: Jiang, Schroeder, Selle, Teran & Stomakhin 2015, "The Affine Particle-
+// In-Cell Method", ACM TOG 34(4); for solids Jiang et al. 2016 (SIGGRAPH course,
+// sec. 10.2).
+//   P2G momentum  m_p (v_p + C_p (x_i - x_p)) w_ip          (eq. 14, C_p = B_p D_p^-1)
+//   force         f_i += -V0_p tau_p grad w_ip               (as PIC)
+//   G2P           v_p = sum w v_i,  B_p = sum w v_i (x_i - x_p)^T  (eq. 10)
+//   F update      F_p <- (I + dt sum v_i grad w^T) F_p       (as PIC)
+// Angular momentum, including the affine part m_p (C_p D_p)^T : eps, is
+// conserved by both transfers (sec. 5.3).
+#pragma once
+
+#include <string_view>
+
+#include "core/parameters.hpp"
+#include "core/particles.hpp"
+#include "transfers/affine.hpp"
+
+namespace mpmtb {
+
+template <int Dim, class Kernel>
+class ApicPolicy {
+  using V = Vec<Dim>;
+  using M = Mat<Dim>;
+
+ public:
+  ApicPolicy(Parameters&, Real dx) : moments_(dx) {}
+
+  struct Source {
+    Real m;
+    V mv;
+    M mC;
+    M tauV;
+  };
+  Source prepare(const Particles<Dim>& P, int p, const M& tauV) const {
+    return {P.m[p], P.m[p] * P.v[p], P.m[p] * P.C[p], tauV};
+  }
+  void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
+               V& f_i) const {
+    m_i += w * s.m;
+    p_i += w * s.mv + s.mC * (w * d);
+    f_i -= s.tauV * grad;
+  }
+
+  struct Gather {
+    V v = V::Zero();
+    M C = M::Zero();
+    M grad_v = M::Zero();
+  };
+  void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
+    g.v += w * v_i;
+    g.C += v_i * moments_.weight_moment(w, grad, d).transpose();
+    g.grad_v += v_i * grad.transpose();
+  }
+  void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
+    P.v[p] = g.v;
+    P.C[p] = g.C;
+    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    P.x[p] += dt * g.v;
+  }
+
+ private:
+  AffineMoments<Dim, Kernel> moments_;
+};
+
+struct ApicTransfer {
+  static constexpr std::string_view name = "apic";
+  static constexpr std::string_view description =
+      "APIC: affine momentum C_p, kernel-gradient force and F (Jiang et al. 2015)";
+  static constexpr bool affine_momentum = true;
+  static constexpr bool needs_old_velocity = false;
+  template <class Kernel>
+  static constexpr bool supports = true;
+  static constexpr std::string_view unsupported_reason = "";
+  template <int Dim, class Kernel>
+  using Policy = ApicPolicy<Dim, Kernel>;
+};
+
+}  // namespace mpmtb

@@ -1,0 +1,56 @@
+// Every compiled (dimension, transfer, kernel): new variants join the
+// parameterized tests automatically.
+#pragma once
+
+#include <gtest/gtest.h>
+
+#include <string>
+#include <vector>
+
+#include "core/registry.hpp"
+
+namespace mpmtb::testing {
+
+struct Combination {
+  int dim;
+  std::string transfer, kernel;
+};
+inline void PrintTo(const Combination& c, std::ostream* os) {
+  *os << c.dim << "D " << c.transfer << " " << c.kernel;
+}
+
+// affine_only: only the transfers that carry C_p in P2G (APIC-like).
+inline std::vector<Combination> all_combinations(std::vector<int> dims = {1, 2, 3},
+                                                 bool affine_only = false) {
+  std::vector<Combination> out;
+  for (int dim : dims) {
+    for (const auto& t : transfer_list()) {
+      if (affine_only && !t.affine) continue;
+      for (const auto& k : kernel_list()) {
+        if (unsupported_reason(t.name, k.name).empty()) out.push_back({dim, t.name, k.name});
+      }
+    }
+  }
+  return out;
+}
+
+inline std::string combination_name(const ::testing::TestParamInfo<Combination>& info) {
+  return std::to_string(info.param.dim) + "d_" + info.param.transfer + "_" + info.param.kernel;
+}
+
+// Calls f.template operator()<Dim>() for the runtime dimension.
+template <class F>
+void with_dim(int dim, F&& f) {
+  switch (dim) {
+    case 1:
+      f.template operator()<1>();
+      break;
+    case 2:
+      f.template operator()<2>();
+      break;
+    default:
+      f.template operator()<3>();
+  }
+}
+
+}  // namespace mpmtb::testing
