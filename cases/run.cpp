@@ -24,9 +24,9 @@
 namespace mpmtb {
 namespace {
 
-const std::vector<std::string> kSeriesColumns = {"step",  "t",  "kinetic", "strain", "gravity",
-                                                 "total", "px", "py",      "pz",     "Lx",
-                                                 "Ly",    "Lz", "volume",  "J_min",  "J_max"};
+const std::vector<std::string> kSeriesColumns = {
+    "step", "t",  "kinetic", "strain", "gravity", "total", "px",    "py",
+    "pz",   "Lx", "Ly",      "Lz",     "volume",  "J_min", "J_max", "dissipated"};
 
 std::vector<double> series_row(long step, Real t, const Diagnostics& d) {
   return {static_cast<double>(step),
@@ -43,7 +43,8 @@ std::vector<double> series_row(long step, Real t, const Diagnostics& d) {
           d.angular_momentum[2],
           d.volume,
           d.J_min,
-          d.J_max};
+          d.J_max,
+          d.dissipated};
 }
 
 bool all_finite(const std::vector<double>& row) {

@@ -28,9 +28,10 @@ Diagnostics measure(const State<Dim>& s, const Stepper<Dim>& stepper) {
   }
   for (std::size_t m = 0; m < s.materials.size(); ++m) {
     d.strain += s.materials[m]->strain_energy(P, s.material_particles[m]);
+    d.dissipated += s.materials[m]->dissipated_energy(P, s.material_particles[m]);
   }
   d.angular_momentum += stepper.affine_angular_momentum(s);
-  d.total = d.kinetic + d.strain + d.gravity;
+  d.total = d.kinetic + d.strain + d.gravity + d.dissipated;
   if (d.mass > 0) {
     d.center_of_mass = mx / d.mass;
     d.center_of_mass_velocity = d.momentum / d.mass;

@@ -7,11 +7,12 @@ namespace mpmtb {
 
 struct Diagnostics {
   Real mass = 0;
-  Real kinetic = 0;                      // sum m_p |v_p|^2 / 2
-  Real strain = 0;                       // sum V0_p psi(F_p)
-  Real gravity = 0;                      // -sum m_p g . x_p
-  Real total = 0;                        // kinetic + strain + gravity
-  Vec3 momentum = Vec3::Zero();          // sum m_p v_p
+  Real kinetic = 0;              // sum m_p |v_p|^2 / 2
+  Real strain = 0;               // sum V0_p psi(F_p)
+  Real gravity = 0;              // -sum m_p g . x_p
+  Real dissipated = 0;           // energy removed by plastic and damage return maps so far
+  Real total = 0;                // kinetic + strain + gravity + dissipated: the conserved budget
+  Vec3 momentum = Vec3::Zero();  // sum m_p v_p
   Vec3 angular_momentum = Vec3::Zero();  // sum x_p x m_p v_p + affine part
   Real volume = 0;                       // sum V0_p J_p
   Real J_min = 1, J_max = 1;

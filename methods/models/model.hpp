@@ -6,6 +6,7 @@
 
 #include <memory>
 #include <span>
+#include <string>
 #include <string_view>
 #include <vector>
 
@@ -26,6 +27,8 @@ class ConstitutiveModel {
   // Internal variables per particle (plastic J, damage, ...); 0 for pure elasticity.
   virtual int state_size() const { return 0; }
   virtual void initial_state(Real* /*q*/) const {}
+  // Names of the internal variables, in order (for output).
+  virtual std::vector<std::string> state_names() const { return {}; }
 
   // Per-particle formulas, for tests and diagnostics.
   virtual Real energy_density(const Mat<Dim>& F, const Real* q) const = 0;   // psi(F)
@@ -38,11 +41,17 @@ class ConstitutiveModel {
   // sum_p V0_p psi(F_p), summed in particle order (deterministic).
   virtual Real strain_energy(const Particles<Dim>& particles, std::span<const int> ids) const = 0;
   // Plastic or damage return map after F_p is updated; no-op for elasticity.
-  virtual void return_map(Particles<Dim>& /*particles*/, std::span<const int> /*ids*/,
-                          Real /*dt*/) const {}
+  virtual void return_map(Particles<Dim>& particles, std::span<const int> ids, Real dt) const = 0;
+  // Energy the return maps have dissipated so far, sum_p V0_p d_p, so that
+  // kinetic + strain + gravity + dissipated is the conserved budget.
+  virtual Real dissipated_energy(const Particles<Dim>& particles,
+                                 std::span<const int> ids) const = 0;
 };
 
-// Writes the batch loops once. Derived provides psi(F, q), P(F, q), tau(F, q).
+// Writes the batch loops once. Derived provides psi(F, q), P(F, q), tau(F, q),
+// and, for plasticity or damage, project(F, q, dt): the return map of one
+// particle, which may change F (to its elastic part) and q, and
+// dissipated(q): the energy per unit initial volume it has dissipated.
 template <int Dim, class Derived>
 class ModelBase : public ConstitutiveModel<Dim> {
  public:
@@ -56,6 +65,23 @@ class ModelBase : public ConstitutiveModel<Dim> {
       const int p = ids[i];
       tauV[p] = particles.V0[p] * self().tau(particles.F[p], particles.state_of(p));
     }
+  }
+  void return_map(Particles<Dim>& particles, std::span<const int> ids, Real dt) const override {
+    if constexpr (requires(Mat<Dim> & F, Real * q) { self().project(F, q, dt); }) {
+      const long n = static_cast<long>(ids.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+      for (long i = 0; i < n; ++i) {
+        const int p = ids[i];
+        self().project(particles.F[p], particles.state_of(p), dt);
+      }
+    }
+  }
+  Real dissipated_energy(const Particles<Dim>& particles, std::span<const int> ids) const override {
+    Real sum = 0;
+    if constexpr (requires(const Real* q) { self().dissipated(q); }) {
+      for (const int p : ids) sum += particles.V0[p] * self().dissipated(particles.state_of(p));
+    }
+    return sum;
   }
   Real strain_energy(const Particles<Dim>& particles, std::span<const int> ids) const override {
     Real sum = 0;

@@ -19,6 +19,7 @@ namespace mpmtb {
 
 template <int Dim, class Kernel>
 class ApicPolicy {
+ protected:
   using V = Vec<Dim>;
   using M = Mat<Dim>;
 
@@ -36,8 +37,7 @@ class ApicPolicy {
   }
   void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
                V& f_i) const {
-    m_i += w * s.m;
-    p_i += w * s.mv + s.mC * (w * d);
+    scatter_momentum(s, w, d, m_i, p_i);
     f_i -= s.tauV * grad;
   }
 
@@ -58,14 +58,20 @@ class ApicPolicy {
     P.x[p] += dt * g.v;
   }
 
- private:
+ protected:
+  // m_i += w m_p, p_i += w m_p (v_p + C_p (x_i - x_p)): shared with MLS-MPM.
+  void scatter_momentum(const Source& s, Real w, const V& d, Real& m_i, V& p_i) const {
+    m_i += w * s.m;
+    p_i += w * s.mv + s.mC * (w * d);
+  }
   AffineMoments<Dim, Kernel> moments_;
 };
 
 struct ApicTransfer {
   static constexpr std::string_view name = "apic";
   static constexpr std::string_view description =
-      "APIC: affine momentum C_p, kernel-gradient force and F (Jiang et al. 2015)";
+      "APIC: affine momentum C_p, kernel-gradient force and F (Jiang et al. 2015); "
+      "linear: C_p = sum v_i grad w^T";
   static constexpr bool affine_momentum = true;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>

@@ -11,34 +11,25 @@
 
 #include <string_view>
 
-#include "core/parameters.hpp"
-#include "core/particles.hpp"
-#include "transfers/affine.hpp"
+#include "transfers/apic.hpp"
 
 namespace mpmtb {
 
+// MLS-MPM is APIC with the MLS force direction and F updated from C_p.
 template <int Dim, class Kernel>
-class MlsPolicy {
-  using V = Vec<Dim>;
-  using M = Mat<Dim>;
+class MlsPolicy : public ApicPolicy<Dim, Kernel> {
+  using Base = ApicPolicy<Dim, Kernel>;
+  using typename Base::M;
+  using typename Base::Source;
+  using typename Base::V;
 
  public:
-  MlsPolicy(Parameters&, Real dx) : moments_(dx) {}
+  using Base::Base;
 
-  struct Source {
-    Real m;
-    V mv;
-    M mC;
-    M tauV;
-  };
-  Source prepare(const Particles<Dim>& P, int p, const M& tauV) const {
-    return {P.m[p], P.m[p] * P.v[p], P.m[p] * P.C[p], tauV};
-  }
   void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
                V& f_i) const {
-    m_i += w * s.m;
-    p_i += w * s.mv + s.mC * (w * d);
-    f_i -= s.tauV * moments_.weight_moment(w, grad, d);
+    this->scatter_momentum(s, w, d, m_i, p_i);
+    f_i -= s.tauV * this->moments_.weight_moment(w, grad, d);
   }
 
   struct Gather {
@@ -47,7 +38,7 @@ class MlsPolicy {
   };
   void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
     g.v += w * v_i;
-    g.C += v_i * moments_.weight_moment(w, grad, d).transpose();
+    g.C += v_i * this->moments_.weight_moment(w, grad, d).transpose();
   }
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
     P.v[p] = g.v;
@@ -55,15 +46,12 @@ class MlsPolicy {
     P.F[p] = (M::Identity() + dt * g.C) * P.F[p];
     P.x[p] += dt * g.v;
   }
-
- private:
-  AffineMoments<Dim, Kernel> moments_;
 };
 
 struct MlsTransfer {
   static constexpr std::string_view name = "mls";
   static constexpr std::string_view description =
-      "MLS-MPM: affine momentum, MLS force, F from C (Hu et al. 2018)";
+      "MLS-MPM: APIC with the MLS force and F from C (Hu et al. 2018); linear: gradient form";
   static constexpr bool affine_momentum = true;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>

@@ -84,3 +84,38 @@ TEST(Walls, SeparateHoldsOnlyInward) {
 
 }  // namespace
 }  // namespace mpmtb
+
+namespace mpmtb {
+namespace {
+
+// Pinned particles hold every node they touch at rest, so they do not move at
+// all, while the rest of the body sags under gravity.
+TEST(Pins, PinnedParticlesStayPutUnderGravity) {
+  for (const char* transfer : {"pic", "flip", "apic", "mls"}) {
+    const Scene scene = testing::scene_from_toml(
+        testing::free_body_toml(2, transfer, "quadratic",
+                                "[physics]\ngravity = [0.0, -9.81, 0.0]\n"
+                                "[[pins]]\nmin = [0.0, 0.55, 0.0]\nmax = [1.0, 1.0, 1.0]\n"),
+        {.set = {"bodies.0.velocity=[0,0,0]", "bodies.0.angular_velocity=[0,0,0]"}});
+    State<2> s = build_state<2>(scene);
+    Parameters params;
+    auto st = make_stepper<2>(transfer, "quadratic", params);
+    const auto x0 = s.particles.x;
+    for (int i = 0; i < 100; ++i) st->step(s, 1e-3);
+    int pinned = 0;
+    Real sag = 0;
+    for (std::size_t p = 0; p < x0.size(); ++p) {
+      if (s.particles.pinned[p]) {
+        ++pinned;
+        EXPECT_EQ(s.particles.x[p], x0[p]) << transfer << " pinned particle " << p << " moved";
+      } else {
+        sag = std::max(sag, x0[p][1] - s.particles.x[p][1]);
+      }
+    }
+    EXPECT_GT(pinned, 0);
+    EXPECT_GT(sag, 1e-3) << transfer << ": the free part must fall";
+  }
+}
+
+}  // namespace
+}  // namespace mpmtb
