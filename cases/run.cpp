@@ -10,6 +10,7 @@
 #include "core/diagnostics.hpp"
 #include "core/errors.hpp"
 #include "core/registry.hpp"
+#include "extra_columns.hpp"
 #include "output.hpp"
 #include "references/reference.hpp"
 #include "setup.hpp"
@@ -134,11 +135,14 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
 
   CsvTable series;
   series.header = kSeriesColumns;
+  const ExtraColumns<Dim> extra(s);
+  for (const auto& c : extra.names()) series.header.push_back(c);
   if (reference) {
     for (const auto& c : reference->columns()) series.header.push_back(c);
   }
   auto sample = [&](const Diagnostics& d) {
     auto row = series_row(s.step, s.time, d);
+    for (double v : extra.values(s)) row.push_back(v);
     if (reference) {
       for (Real v : reference->sample(s, d)) row.push_back(v);
     }
@@ -184,8 +188,8 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
       const Diagnostics d = measure(s, *stepper);
       auto row = sample(d);
       // Energy above the limit times what was put in (initial kinetic + strain
-      // energy plus the work of gravity) means the scheme is amplifying.
-      const Real put_in = d0.kinetic + d0.strain + d0.gravity - d.gravity;
+      // energy plus the work of gravity and colliders) means the scheme is amplifying.
+      const Real put_in = d0.kinetic + d0.strain + d0.gravity - d.gravity + s.collider_work;
       if (!all_finite(row)) {
         status = "unstable";
         reason = "non-finite diagnostics";

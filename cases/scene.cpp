@@ -177,6 +177,22 @@ void read_bodies(TableReader& top, Scene& s) {
     }
     s.bodies.push_back(b);
   }
+  if (top.has("colliders")) {
+    const auto colliders = top.table_array("colliders");
+    for (std::size_t i = 0; i < colliders.size(); ++i) {
+      const std::string path = fmt::format("colliders[{}]", i);
+      TableReader r(*colliders[i], path);
+      r.choice("shape", {"sphere"});
+      SphereCollider c;
+      c.start = r.vec3("center");
+      c.radius = r.number("radius", Range::positive());
+      c.velocity = r.vec3_or("velocity", Vec3::Zero());
+      c.wall = parse_wall(r.string_or("wall", "sticky"), path + ".wall");
+      r.finish();
+      if (c.wall == Wall::free) throw InputError(path + ".wall: a collider cannot be free");
+      s.colliders.push_back(c);
+    }
+  }
   if (top.has("pins")) {
     const auto pins = top.table_array("pins");
     for (std::size_t i = 0; i < pins.size(); ++i) {

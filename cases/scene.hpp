@@ -11,6 +11,7 @@
 #include <string>
 #include <vector>
 
+#include "boundary/colliders.hpp"
 #include "core/parameters.hpp"
 #include "core/types.hpp"
 
@@ -58,6 +59,7 @@ struct Scene {
   std::vector<MaterialSpec> materials;
   std::vector<BodySpec> bodies;
   std::vector<PinSpec> pins;
+  std::vector<SphereCollider> colliders;
   std::string reference;  // analytic reference kind, empty for none
   Parameters reference_params;
   Real energy_limit = 2;  // unstable when K + S exceeds this times the energy put in

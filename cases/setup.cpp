@@ -86,6 +86,7 @@ State<Dim> build_state(const Scene& scene) {
     s.walls.face[2 * a + 1] = parse_wall(scene.walls[2 * a + 1], "boundary");
   }
   s.gravity = head<Dim>(scene.gravity);
+  s.colliders.spheres = scene.colliders;
   seed_particles(scene, s);
   for (std::size_t p = 0; p < s.particles.size(); ++p) {
     s.materials[s.particles.material[p]]->initial_state(s.particles.state_of(p));

@@ -51,20 +51,28 @@ class Solver final : public Stepper<Dim> {
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
     for (long i = 0; i < n; ++i) g.f[i] += g.m[i] * gravity;
     s.walls.fold(g);
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    Real rx = 0, ry = 0, rz = 0;  // reaction of the pinned nodes
+#pragma omp parallel for schedule(static) reduction(+ : rx, ry, rz) if (n >= kParallelMinimum)
     for (long i = 0; i < n; ++i) {
-      if (g.m[i] > 0 && !g.pinned[i]) {
+      if (g.m[i] > 0) {
         const Real inv_m = 1 / g.m[i];
         const Vec<Dim> v_old = g.p[i] * inv_m;
         if constexpr (Transfer::needs_old_velocity) g.v_old[i] = v_old;
         // Symplectic Euler: v_i^{n+1} = v_i^n + dt f_i / m_i (f_i includes m_i g).
         g.v[i] = v_old + dt * inv_m * g.f[i];
+        if (g.pinned[i]) {
+          const Vec3 reaction = to3<Dim>(-g.m[i] * g.v[i]);
+          rx += reaction[0], ry += reaction[1], rz += reaction[2];
+          g.v[i].setZero();
+        }
       } else {
         g.v_old[i].setZero();
         g.v[i].setZero();
       }
     }
+    s.pin_impulse += Vec3(rx, ry, rz);
     s.walls.apply(g);
+    if (!s.colliders.empty()) s.colliders.apply(g, s.time + dt, s.collider_impulse, s.collider_work);
   }
 
   StepReport grid_to_particles(State<Dim>& s, Real dt) override {

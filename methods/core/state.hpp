@@ -5,6 +5,7 @@
 #include <memory>
 #include <vector>
 
+#include "boundary/colliders.hpp"
 #include "boundary/walls.hpp"
 #include "core/grid.hpp"
 #include "core/particles.hpp"
@@ -19,6 +20,12 @@ struct State {
   std::vector<std::unique_ptr<ConstitutiveModel<Dim>>> materials;
   std::vector<std::vector<int>> material_particles;  // particle ids of each material
   Walls<Dim> walls;
+  Colliders<Dim> colliders;
+  // Momentum given to the material so far by the colliders and by the pinned
+  // nodes (their reaction), for the momentum balance.
+  Vec3 collider_impulse = Vec3::Zero();
+  Vec3 pin_impulse = Vec3::Zero();
+  Real collider_work = 0;  // work the colliders did on the material
   Vec<Dim> gravity = Vec<Dim>::Zero();
   // Optional body force per unit mass b(x_p, p, t) (manufactured solutions).
   std::function<Vec<Dim>(const Particles<Dim>&, int p, Real t)> body_force;
