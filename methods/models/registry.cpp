@@ -5,7 +5,11 @@
 #include <functional>
 
 #include "core/errors.hpp"
+#include "models/damage.hpp"
+#include "models/fixed_corotated.hpp"
+#include "models/linear_elastic.hpp"
 #include "models/neo_hookean.hpp"
+#include "models/snow.hpp"
 
 namespace mpmtb {
 namespace {
@@ -31,6 +35,10 @@ ModelEntry entry(std::string description) {
 const std::vector<ModelEntry>& entries() {
   static const std::vector<ModelEntry> list = {
       entry<NeoHookean>("compressible neo-Hookean, E nu density (Bonet & Wood 2008)"),
+      entry<LinearElastic>("small-strain linear elastic, E nu density; not frame indifferent"),
+      entry<FixedCorotated>("fixed-corotated, E nu density; invertible (Stomakhin et al. 2012)"),
+      entry<Snow>("fixed-corotated snow plasticity, theta_c theta_s xi (Stomakhin et al. 2013)"),
+      entry<Damage>("isotropic damage, neo-Hookean tension split (CD-MPM 2019, AnisoMPM 2020)"),
   };
   return list;
 }

@@ -48,7 +48,9 @@ TEST_P(Collider, MomentumBalancePinningPenetrationAndEnergy) {
     EXPECT_LE((d.momentum - expected).norm(), 1e-10 * s.collider_impulse.norm()) << what;
     EXPECT_GT(s.collider_impulse.norm(), 0.1) << what << ": the ball must hit the sheet";
     for (std::size_t p = 0; p < x0.size(); ++p) {
-      if (s.particles.pinned[p]) ASSERT_EQ(s.particles.x[p], x0[p]) << what;
+      if (s.particles.pinned[p]) {
+        ASSERT_EQ(s.particles.x[p], x0[p]) << what;
+      }
     }
     // Grid-node collisions: particles may sink into the ball by less than a cell.
     EXPECT_LT(max_penetration, 0.5 * s.grid.geo.dx) << what;

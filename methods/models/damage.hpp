@@ -1,0 +1,163 @@
+// Isotropic continuum damage on compressible neo-Hookean elasticity, after
+//   Wolper, Fang, Li, Lu, Gao, Jiang 2019, "CD-MPM: Continuum Damage Material
+//     Point Methods for Dynamic Fracture Animation", ACM TOG 38(4): degradation
+//     g = (1 - k) c^2 + k of the tensile energy only, c = 1 - d;
+//   Wolper, Chen, Li, Fang, Jiang 2020, "AnisoMPM: Animating Anisotropic
+//     Damage Mechanics", ACM TOG 39(4): the stress-driven damage evolution
+//       eta dd/dt = <(1 - d) D~ - (d - l0^2 lap d)>,  D~ = zeta <phi - 1>,
+//     here isotropic (no structural tensor) with phi = sigma_max / sigma_crit.
+//   Equation numbers are not given: they were not checked against the papers.
+// The l0^2 lap d regularization needs the grid (a nonlocal term); this model is
+// local, so it is left out and `l0` is not a parameter. Future work.
+//
+// Energy: psi(F, d) = g(d) psi+(F) + psi-(F), g(d) = (1 - d)^2 (1 - k) + k.
+// Split (Amor, Marigo & Maurini 2009, volumetric-deviatoric, adapted to
+// neo-Hookean). With J = det F, s = J^(2/dim), the neo-Hookean energy
+//   psi = mu/2 (tr F^T F - dim) - mu ln J + lambda/2 (ln J)^2
+// is split exactly as psi = psi_dev + psi_vol with
+//   psi_vol(J) = psi(J^(1/dim) I) = mu dim/2 (s - 1) - mu ln J + lambda/2 (ln J)^2,
+//   psi_dev(F) = psi - psi_vol   = mu/2 (tr F^T F - dim s).
+// psi_vol is the energy of the pure dilation with the same J; psi_dev >= 0 by
+// AM-GM on the eigenvalues of F^T F (tr C >= dim det(C)^(1/dim)), = 0 iff F is
+// a rotation times a dilation; psi_dev = 0 identically in 1D. Then
+//   J >= 1: psi+ = psi_dev + psi_vol,  psi- = 0;
+//   J <  1: psi+ = psi_dev,            psi- = psi_vol.
+// psi+ + psi- = psi exactly, psi+ >= 0 always (for x = ln J > 0,
+// psi_vol >= (lambda/2 + mu/dim) x^2 = K/2 x^2 with bulk modulus K > 0), and
+// psi- = psi_vol >= 0 whenever lambda >= 0 (nu >= 0); for nu < 0 it is >= 0
+// near J = 1 but the neo-Hookean energy itself turns negative under extreme
+// compression. psi_vol(1) = psi_vol'(1) = 0, so the switch at J = 1 is C^1.
+// A fully damaged particle (g = k) under J < 1 keeps the whole volumetric
+// stress (all of it in 1D and under pure dilation) but no tensile stress.
+// Stresses (d held fixed; F^-T the inverse transpose):
+//   P_dev = mu (F - s F^-T),                   tau_dev = mu (F F^T - s I),
+//   P_vol = (mu (s - 1) + lambda ln J) F^-T,   tau_vol = (mu (s - 1) + lambda ln J) I.
+//
+// Damage driver (project, after F is updated): sigma_max = the largest
+// principal value of the UNDAMAGED Cauchy stress tau(F, d = 0) / J,
+// phi = sigma_max / sigma_crit, D~ = zeta <phi - 1>,
+//   d <- min(1, d + dt/eta <(1 - d) D~ - d>),
+// so d never decreases, stays in [0, 1], and grows only once phi > 1. The
+// elastic energy released at fixed F, (g(d_old) - g(d_new)) psi+(F), is added
+// to the dissipated energy, keeping kinetic + strain + gravity + dissipated.
+// Parameters: E, nu, density; sigma_crit > 0 (required); zeta > 0 (1);
+// eta > 0 (1e-3, a time scale: smaller = faster); k in [0, 1) (1e-6).
+// State per particle: {damage d, dissipated energy per unit initial volume}.
+#pragma once
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "models/lame.hpp"
+#include "models/model.hpp"
+
+namespace mpmtb {
+
+template <int Dim>
+class Damage final : public ModelBase<Dim, Damage<Dim>> {
+ public:
+  static constexpr std::string_view model_name = "damage";
+  enum StateIndex { kDamage = 0, kDissipated = 1 };
+
+  explicit Damage(Parameters& params)
+      : c_(ElasticConstants::read(params)),
+        sigma_crit_(params.required("sigma_crit", Range::positive())),
+        zeta_(params.optional("zeta", 1, Range::positive())),
+        eta_(params.optional("eta", 1e-3, Range::positive())),
+        k_(params.optional("k", 1e-6, Range::half_open(0, 1))) {}
+
+  std::string_view name() const override { return model_name; }
+  Real density() const override { return c_.density; }
+  Real wave_speed() const override { return c_.wave_speed(); }
+  int state_size() const override { return 2; }
+  void initial_state(Real* q) const override {
+    q[kDamage] = 0;
+    q[kDissipated] = 0;
+  }
+  std::vector<std::string> state_names() const override { return {"damage", "dissipated"}; }
+
+  Real sigma_crit() const { return sigma_crit_; }
+  Real degradation(Real d) const { return (1 - d) * (1 - d) * (1 - k_) + k_; }
+
+  // The tensile (degraded) and compressive (kept) parts of the energy.
+  struct Split {
+    Real plus = 0, minus = 0;
+  };
+  Split split(const Mat<Dim>& F) const {
+    const Real J = F.determinant(), logJ = std::log(J), s = pow_2_over_dim(J);
+    // Rounding can leave tr C - dim s a few ulps below its bound 0.
+    const Real dev = std::max(Real(0), Real(0.5) * c_.mu * ((F.transpose() * F).trace() - Dim * s));
+    const Real vol =
+        Real(0.5) * c_.mu * Dim * (s - 1) - c_.mu * logJ + Real(0.5) * c_.lambda * logJ * logJ;
+    return J >= 1 ? Split{dev + vol, 0} : Split{dev, vol};
+  }
+
+  Real psi(const Mat<Dim>& F, const Real* q) const {
+    const Split e = split(F);
+    return degradation(damage(q)) * e.plus + e.minus;
+  }
+  Mat<Dim> P(const Mat<Dim>& F, const Real* q) const {
+    const Real J = F.determinant(), s = pow_2_over_dim(J);
+    const Mat<Dim> F_invT = F.inverse().transpose();
+    const Mat<Dim> P_dev = c_.mu * (F - s * F_invT);
+    const Mat<Dim> P_vol = (c_.mu * (s - 1) + c_.lambda * std::log(J)) * F_invT;
+    const Real g = degradation(damage(q));
+    return J >= 1 ? Mat<Dim>(g * (P_dev + P_vol)) : Mat<Dim>(g * P_dev + P_vol);
+  }
+  Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
+    return tau_with(F, degradation(damage(q)));
+  }
+  // Undamaged Cauchy stress sigma = tau(F, d = 0) / J: the damage driver.
+  Mat<Dim> undamaged_cauchy(const Mat<Dim>& F) const { return tau_with(F, 1) / F.determinant(); }
+  Real max_principal_stress(const Mat<Dim>& F) const {
+    const Mat<Dim> sigma = undamaged_cauchy(F);
+    if constexpr (Dim == 1) {
+      return sigma(0, 0);
+    } else {
+      const Mat<Dim> sym = Real(0.5) * (sigma + sigma.transpose());
+      Eigen::SelfAdjointEigenSolver<Mat<Dim>> eig(sym, Eigen::EigenvaluesOnly);
+      return eig.eigenvalues().maxCoeff();
+    }
+  }
+
+  // Local damage update at fixed F; F itself is not changed.
+  void project(Mat<Dim>& F, Real* q, Real dt) const {
+    const Real d_old = q[kDamage];
+    if (d_old >= 1) return;
+    // D~ = zeta <phi - 1> with phi = sigma_max / sigma_crit, written so that
+    // D~ > 0 exactly when sigma_max > sigma_crit (no rounding of the quotient).
+    const Real excess = max_principal_stress(F) - sigma_crit_;
+    const Real D = excess > 0 ? zeta_ * excess / sigma_crit_ : Real(0);
+    const Real rate = std::max(Real(0), (1 - d_old) * D - d_old);
+    if (!(rate > 0)) return;  // also guards against NaN
+    const Real d_new = std::min(Real(1), d_old + dt / eta_ * rate);
+    if (!(d_new > d_old)) return;
+    q[kDissipated] += (degradation(d_old) - degradation(d_new)) * split(F).plus;
+    q[kDamage] = d_new;
+  }
+  Real dissipated(const Real* q) const { return q[kDissipated]; }
+
+ private:
+  static Real damage(const Real* q) { return q ? q[kDamage] : Real(0); }
+  static Real pow_2_over_dim(Real J) {
+    if constexpr (Dim == 1) return J * J;
+    if constexpr (Dim == 2) return J;
+    if constexpr (Dim == 3) return std::cbrt(J * J);
+  }
+  // Kirchhoff stress with the tensile part scaled by g.
+  Mat<Dim> tau_with(const Mat<Dim>& F, Real g) const {
+    const Real J = F.determinant(), s = pow_2_over_dim(J);
+    const Mat<Dim> I = Mat<Dim>::Identity();
+    const Mat<Dim> tau_dev = c_.mu * (F * F.transpose() - s * I);
+    const Mat<Dim> tau_vol = (c_.mu * (s - 1) + c_.lambda * std::log(J)) * I;
+    return J >= 1 ? Mat<Dim>(g * (tau_dev + tau_vol)) : Mat<Dim>(g * tau_dev + tau_vol);
+  }
+
+  ElasticConstants c_;
+  Real sigma_crit_, zeta_, eta_, k_;
+};
+
+}  // namespace mpmtb

@@ -1,0 +1,139 @@
+// Rotation-variant ("signed") SVD and polar decomposition of a deformation
+// gradient in 1, 2 and 3 dimensions, and the cofactor matrix.
+//
+// signed_svd: F = U Sigma V^T with U and V proper rotations (det +1); the sign
+// of det F goes into the last singular value, so sigma_1 >= ... >= |sigma_d|
+// and sigma_d < 0 exactly when F is inverted (det F < 0). This is the
+// invertible-element SVD of Irving, Teran & Fedkiw 2004 ("Invertible finite
+// elements for robust simulation of large deformation", SCA, sec. 4) as used
+// by Stomakhin, Howes, Schroeder & Teran 2012 ("Energetically consistent
+// invertible elasticity", SCA, sec. 3).
+//
+// polar: F = R S with R = U V^T a rotation (det +1) also for reflected and
+// (near-)singular F, and S = V Sigma V^T symmetric (not positive definite when
+// det F < 0). R is the rotation closest to F in the Frobenius norm.
+//
+// 2x2: closed form from the rotation/reflection split of F: writing
+//   E = (F00 + F11)/2, H = (F10 - F01)/2 (the rotation part, angle a2),
+//   D = (F00 - F11)/2, G = (F10 + F01)/2 (the reflection part, angle a1),
+// F = Rot(alpha) diag(q + r, q - r) Rot(beta) with q = |(E, H)|, r = |(D, G)|,
+// alpha = (a2 + a1)/2, beta = (a2 - a1)/2, so U = Rot(alpha), V = Rot(-beta)
+// and R = Rot(a2) = [E -H; H E] / q. 3x3: Eigen::JacobiSVD, then the sign of a
+// reflected U or V is moved into sigma_3 (Irving et al. 2004, sec. 4).
+#pragma once
+
+#include <Eigen/SVD>
+#include <cmath>
+
+#include "core/types.hpp"
+
+namespace mpmtb {
+
+template <int Dim>
+struct SignedSvd {
+  Mat<Dim> U;      // rotation, det U = +1
+  Vec<Dim> sigma;  // sigma_1 >= ... >= |sigma_d|; sign(sigma_d) = sign(det F)
+  Mat<Dim> V;      // rotation, det V = +1
+};
+
+template <int Dim>
+struct PolarDecomposition {
+  Mat<Dim> R;  // rotation, det R = +1
+  Mat<Dim> S;  // symmetric, F = R S
+};
+
+namespace detail {
+inline Mat<2> rotation2(Real c, Real s) {
+  Mat<2> R;
+  R << c, -s, s, c;
+  return R;
+}
+}  // namespace detail
+
+template <int Dim>
+SignedSvd<Dim> signed_svd(const Mat<Dim>& F) {
+  static_assert(Dim >= 1 && Dim <= 3);
+  SignedSvd<Dim> out;
+  if constexpr (Dim == 1) {
+    out.U = out.V = Mat<1>::Identity();
+    out.sigma(0) = F(0, 0);
+  } else if constexpr (Dim == 2) {
+    const Real E = Real(0.5) * (F(0, 0) + F(1, 1)), H = Real(0.5) * (F(1, 0) - F(0, 1));
+    const Real D = Real(0.5) * (F(0, 0) - F(1, 1)), G = Real(0.5) * (F(1, 0) + F(0, 1));
+    const Real q = std::hypot(E, H), r = std::hypot(D, G);
+    const Real a1 = std::atan2(G, D), a2 = std::atan2(H, E);
+    const Real alpha = Real(0.5) * (a2 + a1), beta = Real(0.5) * (a2 - a1);
+    out.U = detail::rotation2(std::cos(alpha), std::sin(alpha));
+    out.V = detail::rotation2(std::cos(beta), -std::sin(beta));
+    out.sigma << q + r, q - r;
+  } else {
+// GCC 12 at -O3 reports a false -Wmaybe-uninitialized inside Eigen's fixed-size
+// JacobiSVD (its singular values are all written by compute()).
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wmaybe-uninitialized"
+#endif
+    const Eigen::JacobiSVD<Mat<3>> svd(F, Eigen::ComputeFullU | Eigen::ComputeFullV);
+    out.U = svd.matrixU();
+    out.V = svd.matrixV();
+    out.sigma = svd.singularValues();
+#if defined(__GNUC__) && !defined(__clang__)
+#pragma GCC diagnostic pop
+#endif
+    if (out.U.determinant() < 0) {
+      out.U.col(2) *= -1;
+      out.sigma(2) *= -1;
+    }
+    if (out.V.determinant() < 0) {
+      out.V.col(2) *= -1;
+      out.sigma(2) *= -1;
+    }
+  }
+  return out;
+}
+
+// R of the polar decomposition F = R S (a rotation for every F).
+template <int Dim>
+Mat<Dim> polar_rotation(const Mat<Dim>& F) {
+  if constexpr (Dim == 1) {
+    return Mat<1>::Identity();
+  } else if constexpr (Dim == 2) {
+    const Real E = Real(0.5) * (F(0, 0) + F(1, 1)), H = Real(0.5) * (F(1, 0) - F(0, 1));
+    const Real q = std::hypot(E, H);
+    if (!(q > 0)) return Mat<2>::Identity();  // F = symmetric traceless: R = I is a minimizer
+    return detail::rotation2(E / q, H / q);
+  } else {
+    const SignedSvd<3> svd = signed_svd<3>(F);
+    return svd.U * svd.V.transpose();
+  }
+}
+
+template <int Dim>
+PolarDecomposition<Dim> polar(const Mat<Dim>& F) {
+  PolarDecomposition<Dim> out;
+  out.R = polar_rotation<Dim>(F);
+  const Mat<Dim> S = out.R.transpose() * F;  // symmetric up to round-off
+  out.S = Real(0.5) * (S + S.transpose());
+  return out;
+}
+
+// cof(F) = J F^-T, written without the inverse so that it is defined for
+// singular and inverted F (d det F / dF = cof F).
+template <int Dim>
+Mat<Dim> cofactor(const Mat<Dim>& F) {
+  if constexpr (Dim == 1) {
+    return Mat<1>::Identity();
+  } else if constexpr (Dim == 2) {
+    Mat<2> C;
+    C << F(1, 1), -F(1, 0), -F(0, 1), F(0, 0);
+    return C;
+  } else {
+    Mat<3> C;
+    C.col(0) = F.col(1).cross(F.col(2));
+    C.col(1) = F.col(2).cross(F.col(0));
+    C.col(2) = F.col(0).cross(F.col(1));
+    return C;
+  }
+}
+
+}  // namespace mpmtb

@@ -1,0 +1,109 @@
+// Snow: elastoplasticity of Stomakhin, Schroeder, Chai, Chu & Teran 2013,
+// "A material point method for snow simulation", ACM Trans. Graph. 32(4)
+// (SIGGRAPH), sec. 5-6. F = F_E F_P; the particle's F is the elastic part F_E
+// and the plastic part enters only through J_P = det F_P.
+//   psi(F_E, J_P) = mu |F_E - R_E|^2 + lambda/2 (J_E - 1)^2   (fixed-corotated,
+//                   fixed_corotated.hpp, of the elastic part)
+//   mu = mu0 exp(xi (1 - J_P)), lambda = lambda0 exp(xi (1 - J_P))   (hardening)
+// Return map (project): F_E^trial = U Sigma V^T (signed SVD, polar.hpp);
+// Sigma is clamped to [1 - theta_c, 1 + theta_s]; F_E = U Sigma_c V^T and
+// J_P <- J_P det(Sigma) / det(Sigma_c), so that J = J_E J_P, the determinant of
+// the total deformation, is what G2P produced. Defaults theta_c = 2.5e-2,
+// theta_s = 7.5e-3, xi = 10 are the paper's reference snow.
+//
+// Energy budget. The return map changes neither positions nor velocities;
+// it replaces the stored energy psi(F_E^trial; J_P^old) by
+// psi(F_E; J_P^new). The difference is the energy the plastic flow removed, and
+// it is added to `dissipated` (state q[1]) with its sign, so that
+// kinetic + strain + gravity + dissipated is conserved through every return
+// map exactly (up to round-off), as ConstitutiveModel::dissipated_energy
+// promises. Under monotone stretching or compression the increment is
+// positive: every singular value moves towards 1 from one side. The clamp is
+// not derived from a dissipation potential, though, and the hardening raises
+// the stiffness when J_P drops, so the clamp can also raise psi: in mixed
+// states (one direction yields in stretch while the volume is compressed, as
+// for a few steps at the onset of yield in simple shear) and after a sudden
+// large compression (hardening outgrows the released energy). Such a step
+// injects energy; it shows as a decrease of `dissipated` rather than as an
+// unexplained drift of the total. Clipping the increment at zero would keep
+// `dissipated` monotone but break the budget. tests/unit/snow_test.cpp shows
+// both cases.
+//
+// An inverted trial F (det < 0) would give J_P < 0; the step loop reports
+// J <= 0 after G2P as unstable before that matters.
+// wave_speed() is that of the unhardened material (mu0, lambda0): the CFL time
+// step does not follow the hardening (exp(xi (1 - J_P)) grows when J_P < 1).
+#pragma once
+
+#include <cmath>
+#include <string>
+#include <vector>
+
+#include "models/fixed_corotated.hpp"
+#include "models/lame.hpp"
+#include "models/model.hpp"
+#include "models/polar.hpp"
+
+namespace mpmtb {
+
+template <int Dim>
+class Snow final : public ModelBase<Dim, Snow<Dim>> {
+ public:
+  static constexpr std::string_view model_name = "snow";
+  enum StateIndex { kJP = 0, kDissipated = 1 };
+
+  explicit Snow(Parameters& params)
+      : c_(ElasticConstants::read(params)),
+        theta_c_(params.optional("theta_c", 2.5e-2, Range::open(0, 1))),
+        theta_s_(params.optional("theta_s", 7.5e-3, Range::positive())),
+        xi_(params.optional("xi", 10, Range::non_negative())) {}
+
+  std::string_view name() const override { return model_name; }
+  Real density() const override { return c_.density; }
+  Real wave_speed() const override { return c_.wave_speed(); }
+  int state_size() const override { return 2; }
+  void initial_state(Real* q) const override {
+    q[kJP] = 1;
+    q[kDissipated] = 0;
+  }
+  std::vector<std::string> state_names() const override { return {"J_P", "dissipated"}; }
+
+  Real theta_c() const { return theta_c_; }
+  Real theta_s() const { return theta_s_; }
+  // Hardened Lame parameters for the state q.
+  Real mu(const Real* q) const { return c_.mu * hardening(q[kJP]); }
+  Real lambda(const Real* q) const { return c_.lambda * hardening(q[kJP]); }
+
+  Real psi(const Mat<Dim>& F, const Real* q) const {
+    return hardening(q[kJP]) * fixed_corotated_psi<Dim>(F, c_.mu, c_.lambda);
+  }
+  Mat<Dim> P(const Mat<Dim>& F, const Real* q) const {
+    return hardening(q[kJP]) * fixed_corotated_P<Dim>(F, c_.mu, c_.lambda);
+  }
+  Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
+    return hardening(q[kJP]) * fixed_corotated_tau<Dim>(F, c_.mu, c_.lambda);
+  }
+
+  // The return map of one particle: F is the trial elastic part on entry and
+  // the clamped elastic part on exit. A trial state inside the elastic region
+  // is left untouched (bit for bit).
+  void project(Mat<Dim>& F, Real* q, Real /*dt*/) const {
+    const SignedSvd<Dim> svd = signed_svd<Dim>(F);
+    const Real lo = 1 - theta_c_, hi = 1 + theta_s_;
+    if ((svd.sigma.array() >= lo).all() && (svd.sigma.array() <= hi).all()) return;
+    const Real psi_trial = psi(F, q);
+    const Vec<Dim> clamped = svd.sigma.cwiseMax(lo).cwiseMin(hi);
+    F = svd.U * clamped.asDiagonal() * svd.V.transpose();
+    q[kJP] *= svd.sigma.prod() / clamped.prod();
+    q[kDissipated] += psi_trial - psi(F, q);
+  }
+  Real dissipated(const Real* q) const { return q[kDissipated]; }
+
+ private:
+  Real hardening(Real J_P) const { return std::exp(xi_ * (1 - J_P)); }
+
+  ElasticConstants c_;
+  Real theta_c_, theta_s_, xi_;
+};
+
+}  // namespace mpmtb

@@ -1,0 +1,359 @@
+// Damage model (REFERENCE.md, "Damage"; methods/models/damage.hpp) in 1, 2 and 3D.
+#include <gtest/gtest.h>
+
+#include <Eigen/Eigenvalues>
+#include <Eigen/Geometry>
+#include <cmath>
+#include <map>
+#include <numbers>
+#include <random>
+#include <regex>
+#include <string>
+#include <type_traits>
+#include <utility>
+#include <vector>
+
+#include "core/errors.hpp"
+#include "core/parameters.hpp"
+#include "core/types.hpp"
+#include "models/damage.hpp"
+#include "models/neo_hookean.hpp"
+
+namespace mpmtb {
+namespace {
+
+constexpr Real kE = 250, kNu = 0.3, kRho = 7, kSigmaCrit = 20;
+// Lame constants derived here, independently of the class under test.
+constexpr Real kMu = kE / (2 * (1 + kNu));
+constexpr Real kLambda = kE * kNu / ((1 + kNu) * (1 - 2 * kNu));
+
+std::map<std::string, Real> Valid() {
+  return {{"E", kE}, {"nu", kNu}, {"density", kRho}, {"sigma_crit", kSigmaCrit}};
+}
+std::map<std::string, Real> With(const std::string& key, Real value) {
+  auto v = Valid();
+  v[key] = value;
+  return v;
+}
+
+template <int Dim>
+Damage<Dim> MakeDamage(const std::map<std::string, Real>& values = Valid()) {
+  Parameters p("materials.test", values);
+  Damage<Dim> m(p);
+  p.reject_unknown();
+  return m;
+}
+
+template <int Dim>
+Mat<Dim> RandomMatrix(std::mt19937& gen) {
+  std::uniform_real_distribution<Real> u(-1, 1);
+  Mat<Dim> A;
+  for (int k = 0; k < Dim * Dim; ++k) A(k / Dim, k % Dim) = u(gen);
+  return A;
+}
+
+// F = I + 0.3 * random with J >= 0.2, and |J - 1| > 1e-3 so that the finite
+// differences do not straddle the tension/compression switch at J = 1.
+template <int Dim>
+Mat<Dim> RandomF(std::mt19937& gen) {
+  for (;;) {
+    const Mat<Dim> F = Mat<Dim>::Identity() + 0.3 * RandomMatrix<Dim>(gen);
+    const Real J = F.determinant();
+    if (J >= 0.2 && std::abs(J - 1) > 1e-3) return F;
+  }
+}
+
+template <int Dim>
+Mat<Dim> RandomRotation(std::mt19937& gen) {
+  std::uniform_real_distribution<Real> angle(-std::numbers::pi, std::numbers::pi);
+  if constexpr (Dim == 1) {
+    return Mat<Dim>::Identity();
+  } else if constexpr (Dim == 2) {
+    return Eigen::Rotation2D<Real>(angle(gen)).toRotationMatrix();
+  } else {
+    const Vec<3> axis = RandomMatrix<3>(gen).col(0).normalized();
+    return Eigen::AngleAxis<Real>(angle(gen), axis).toRotationMatrix();
+  }
+}
+
+// Uniaxial stretch along x, the other directions held at 1.
+template <int Dim>
+Mat<Dim> Uniaxial(Real stretch) {
+  Mat<Dim> F = Mat<Dim>::Identity();
+  F(0, 0) = stretch;
+  return F;
+}
+
+// Largest principal value of the undamaged Cauchy stress, from the neo-Hookean model.
+template <int Dim>
+Real MaxPrincipal(const NeoHookean<Dim>& nh, const Mat<Dim>& F) {
+  const Mat<Dim> sigma = nh.tau(F, nullptr) / F.determinant();
+  return Eigen::SelfAdjointEigenSolver<Mat<Dim>>(sigma).eigenvalues().maxCoeff();
+}
+
+template <class D>
+class DamageTest : public ::testing::Test {
+ protected:
+  static constexpr int Dim = D::value;
+  Damage<Dim> m_ = MakeDamage<Dim>();
+  Parameters nh_params_{"materials.test", Valid()};
+  NeoHookean<Dim> nh_{nh_params_};  // the undamaged reference
+  std::mt19937 gen_{1234 + Dim};
+};
+using Dims = ::testing::Types<std::integral_constant<int, 1>, std::integral_constant<int, 2>,
+                              std::integral_constant<int, 3>>;
+TYPED_TEST_SUITE(DamageTest, Dims);
+
+// Through the virtual interface, with the damage state held fixed.
+TYPED_TEST(DamageTest, StressIsEnergyGradientAtFixedDamage) {
+  constexpr int Dim = TestFixture::Dim;
+  const ConstitutiveModel<Dim>& m = this->m_;
+  const Real h = 1e-6;
+  for (const Real d : {0.0, 0.3, 1.0}) {
+    const Real q[2] = {d, 0};
+    for (int s = 0; s < 20; ++s) {
+      const Mat<Dim> F = RandomF<Dim>(this->gen_);
+      Mat<Dim> P_fd;
+      for (int i = 0; i < Dim; ++i) {
+        for (int j = 0; j < Dim; ++j) {
+          Mat<Dim> Fp = F, Fm = F;
+          Fp(i, j) += h;
+          Fm(i, j) -= h;
+          P_fd(i, j) = (m.energy_density(Fp, q) - m.energy_density(Fm, q)) / (2 * h);
+        }
+      }
+      const Mat<Dim> P = m.first_piola(F, q);
+      EXPECT_LT((P - P_fd).norm(), 1e-6 * (P.norm() + 1e-3 * kE)) << "d " << d << "\n" << F;
+      const Mat<Dim> PFt = P * F.transpose();
+      EXPECT_LT((this->m_.tau(F, q) - PFt).norm(), 1e-12 * (PFt.norm() + kE));
+    }
+  }
+}
+
+TYPED_TEST(DamageTest, RotationsAreStressFreeAndObjective) {
+  constexpr int Dim = TestFixture::Dim;
+  const auto& m = this->m_;
+  for (const Real d : {0.0, 0.3, 1.0}) {
+    const Real q[2] = {d, 0};
+    for (int s = 0; s < 10; ++s) {
+      const Mat<Dim> R = s == 0 ? Mat<Dim>::Identity() : RandomRotation<Dim>(this->gen_);
+      SCOPED_TRACE(::testing::Message() << "R =\n" << R);
+      EXPECT_LT(m.P(R, q).norm(), 1e-12 * kE);
+      EXPECT_LT(m.tau(R, q).norm(), 1e-12 * kE);
+      EXPECT_LT(std::abs(m.psi(R, q)), 1e-12 * kE);
+      // Objectivity (trivial in 1D, where R = I).
+      const Mat<Dim> F = RandomF<Dim>(this->gen_);
+      const Real psi = m.psi(F, q);
+      EXPECT_NEAR(m.psi(R * F, q), psi, 1e-12 * (std::abs(psi) + kE));
+      EXPECT_NEAR(m.max_principal_stress(R * F), m.max_principal_stress(F), 1e-10 * kE);
+    }
+  }
+  const Real q0[2] = {0, 0};
+  EXPECT_GT(m.P(Mat<Dim>::Identity() * 1.1, q0).norm(), 1e-2 * kE);
+}
+
+TYPED_TEST(DamageTest, SplitIsExactAndNonNegative) {
+  constexpr int Dim = TestFixture::Dim;
+  const auto& nh = this->nh_;
+  const auto& m = this->m_;
+  const Real q0[2] = {0, 0};
+  int tension = 0, compression = 0;
+  for (int s = 0; s < 200; ++s) {
+    const Mat<Dim> F = RandomF<Dim>(this->gen_);
+    const auto e = m.split(F);
+    const Real psi = nh.psi(F, nullptr);
+    EXPECT_NEAR(e.plus + e.minus, psi, 1e-12 * (psi + kE)) << "F =\n" << F;
+    EXPECT_NEAR(m.psi(F, q0), psi, 1e-12 * (psi + kE));
+    EXPECT_LT((m.P(F, q0) - nh.P(F, nullptr)).norm(), 1e-12 * kE);
+    EXPECT_NEAR(m.max_principal_stress(F), MaxPrincipal(nh, F), 1e-10 * kE);
+    EXPECT_GE(e.plus, 0);
+    EXPECT_GE(e.minus, 0);
+    if (F.determinant() > 1) {
+      EXPECT_EQ(e.minus, 0) << "no compressive energy under J > 1";
+      ++tension;
+    } else {
+      EXPECT_GT(e.minus, 0) << "the volumetric energy under J < 1 is kept";
+      ++compression;
+    }
+  }
+  EXPECT_GT(tension, 20);
+  EXPECT_GT(compression, 20);
+}
+
+TYPED_TEST(DamageTest, DamageIsMonotoneAndBounded) {
+  constexpr int Dim = TestFixture::Dim;
+  const auto m = MakeDamage<Dim>(With("eta", 1e-2));
+  std::uniform_real_distribution<Real> u(0, 1);
+  Real q[2] = {-1, -1};
+  m.initial_state(q);
+  ASSERT_TRUE(q[0] == 0 && q[1] == 0);
+  Real d_max_seen = 0;
+  for (int step = 0; step < 2000; ++step) {
+    // Loading/unloading: stretch amplitude follows a noisy cycle, sometimes far past failure.
+    const Real a =
+        0.4 * std::sin(step * 0.01) * std::sin(step * 0.0031) + 0.05 * (u(this->gen_) - 0.5);
+    Mat<Dim> F =
+        Mat<Dim>::Identity() + a * Mat<Dim>::Identity() + 0.1 * RandomMatrix<Dim>(this->gen_);
+    if (F.determinant() < 0.2) continue;
+    const Mat<Dim> F_before = F;
+    const Real d_old = q[0], w_old = q[1];
+    m.project(F, q, 1e-3);
+    EXPECT_EQ(F, F_before) << "damage must not change F";
+    EXPECT_GE(q[0], d_old) << "step " << step;
+    EXPECT_LE(q[0], 1);
+    EXPECT_GE(q[1], w_old) << "dissipation decreased at step " << step;
+    d_max_seen = std::max(d_max_seen, q[0]);
+  }
+  EXPECT_GT(d_max_seen, 0.1) << "the history should damage the particle";
+  // One huge step (dt / eta = 100) far past failure: clamped to exactly 1, then absorbing.
+  Real q1[2] = {0, 0};
+  for (int i = 0; i < 2; ++i) {
+    Mat<Dim> F = Uniaxial<Dim>(1.5);
+    m.project(F, q1, 1);
+    EXPECT_EQ(q1[0], 1);
+  }
+}
+
+// 1D Cauchy stress of the undamaged neo-Hookean bar, computed here from
+// sigma = tau / J, tau = mu (F^2 - 1) + lambda ln F.
+Real Cauchy1D(Real F) {
+  return (kMu * (F * F - 1) + kLambda * std::log(F)) / F;
+}
+
+TYPED_TEST(DamageTest, NoDamageBelowThreshold) {
+  constexpr int Dim = TestFixture::Dim;
+  const auto& m = this->m_;
+  // The uniaxial stretch whose largest principal stress is `ratio` sigma_crit.
+  auto stretch_at = [&](Real ratio) {
+    Real lo = 1, hi = 2;
+    for (int i = 0; i < 200; ++i) {
+      const Real mid = 0.5 * (lo + hi);
+      (MaxPrincipal(this->nh_, Uniaxial<Dim>(mid)) < ratio * kSigmaCrit ? lo : hi) = mid;
+    }
+    return lo;
+  };
+  const Real below = stretch_at(0.99);
+  Real q[2] = {0, 0};
+  for (int step = 0; step < 10000; ++step) {
+    Mat<Dim> F = Uniaxial<Dim>(below);
+    m.project(F, q, 1e-3);
+  }
+  EXPECT_EQ(q[0], 0);
+  EXPECT_EQ(q[1], 0);
+  // Just above the threshold the same loading damages.
+  Mat<Dim> F = Uniaxial<Dim>(stretch_at(1.01));
+  m.project(F, q, 1e-3);
+  EXPECT_GT(q[0], 0);
+  // The driver is the UNDAMAGED stress: at d = 0.2 and 1.5 sigma_crit undamaged
+  // (0.96 sigma_crit degraded), (1 - d) D~ - d = 0.8 * 0.5 - 0.2 > 0: d grows.
+  Real q2[2] = {0.2, 0};
+  F = Uniaxial<Dim>(stretch_at(1.5));
+  EXPECT_NEAR(m.max_principal_stress(F), 1.5 * kSigmaCrit, 1e-9 * kSigmaCrit);
+  m.project(F, q2, 1e-3);
+  EXPECT_NEAR(q2[0], 0.2 + 1e-3 / 1e-3 * 0.2, 1e-9);
+}
+
+TEST(DamageOnset, StartsExactlyAtCriticalStressIn1D) {
+  const auto m = MakeDamage<1>();
+  Real q[2] = {0, 0};
+  int first_damaged = -1, first_over = -1;
+  for (int step = 1; step <= 2000; ++step) {
+    const Real stretch = 1 + 1e-4 * step;
+    if (first_over < 0 && Cauchy1D(stretch) > kSigmaCrit) first_over = step;
+    Mat<1> F = Uniaxial<1>(stretch);
+    m.project(F, q, 1e-4);
+    if (q[0] > 0 && first_damaged < 0) first_damaged = step;
+  }
+  ASSERT_GT(first_over, 1) << "the ramp must start below the critical stress";
+  EXPECT_EQ(first_damaged, first_over);
+  EXPECT_LT(Cauchy1D(1 + 1e-4 * (first_over - 1)), kSigmaCrit);
+}
+
+TYPED_TEST(DamageTest, FullyDamagedCarriesNoTensionButResistsCompression) {
+  constexpr int Dim = TestFixture::Dim;
+  const auto m = MakeDamage<Dim>(With("k", 1e-9));
+  const auto& nh = this->nh_;
+  const Real broken[2] = {1, 0};
+  for (const Real stretch : {1.01, 1.2, 1.5}) {
+    const Mat<Dim> F = Uniaxial<Dim>(stretch);
+    const Real P_intact = nh.P(F, nullptr).norm();
+    EXPECT_LE(m.P(F, broken).norm(), 2e-9 * P_intact) << "stretch " << stretch;
+    EXPECT_LE(m.psi(F, broken), 2e-9 * nh.psi(F, nullptr));
+  }
+  // Compression: in 1D the whole stress, in any dimension under pure dilation.
+  for (const Real s : {0.99, 0.9, 0.7}) {
+    const Mat<Dim> F = s * Mat<Dim>::Identity();
+    const Mat<Dim> P_intact = nh.P(F, nullptr);
+    EXPECT_LT((m.P(F, broken) - P_intact).norm(), 1e-12 * P_intact.norm()) << "s " << s;
+    EXPECT_LT(P_intact(0, 0), 0);
+    if constexpr (Dim > 1) {
+      // Uniaxial compression: keeps the volumetric stress, computed here from
+      // P_vol = (mu (J^(2/dim) - 1) + lambda ln J) F^-T, and loses the shear part.
+      const Mat<Dim> Fu = Uniaxial<Dim>(s);
+      const Real J = Fu.determinant();
+      const Mat<Dim> P_vol = (kMu * (std::pow(J, 2.0 / Dim) - 1) + kLambda * std::log(J)) *
+                             Mat<Dim>(Fu.inverse().transpose());
+      const Mat<Dim> P_broken = m.P(Fu, broken);
+      EXPECT_LT((P_broken - P_vol).norm(), 1e-6 * P_vol.norm()) << "s " << s;
+      EXPECT_LT(P_broken(0, 0), 0);
+      EXPECT_GT(P_broken(0, 0), nh.P(Fu, nullptr)(0, 0)) << "the shear part is degraded";
+    }
+  }
+}
+
+TYPED_TEST(DamageTest, EnergyBudgetAtFixedF) {
+  constexpr int Dim = TestFixture::Dim;
+  const auto m = MakeDamage<Dim>(With("eta", 1e-2));
+  Real q[2] = {0, 0};
+  Real released = 0;
+  for (int step = 0; step < 200; ++step) {
+    Mat<Dim> F = Uniaxial<Dim>(1.3) + 0.02 * RandomMatrix<Dim>(this->gen_);
+    const Real psi_old = m.psi(F, q), w_old = q[1];
+    m.project(F, q, 1e-3);
+    const Real psi_new = m.psi(F, q), w_new = q[1];
+    EXPECT_GE(w_new, w_old);
+    EXPECT_NEAR(psi_old, psi_new + (w_new - w_old), 1e-12 * (psi_old + kE)) << "step " << step;
+    released += psi_old - psi_new;
+  }
+  EXPECT_GT(q[0], 0.5);
+  EXPECT_DOUBLE_EQ(m.dissipated(q), q[1]);
+  EXPECT_NEAR(m.dissipated(q), released, 1e-10 * kE);
+  EXPECT_GT(released, 0);
+}
+
+void ExpectRejected(const std::map<std::string, Real>& values, const std::string& key) {
+  SCOPED_TRACE("expected rejection naming '" + key + "'");
+  try {
+    MakeDamage<2>(values);
+    ADD_FAILURE() << "no InputError";
+  } catch (const InputError& e) {
+    EXPECT_TRUE(std::regex_search(e.what(), std::regex("\\b" + key + "\\b")))
+        << "message: " << e.what();
+  }
+}
+
+TEST(DamageParameters, ValidParametersAreAcceptedAndStateIsNamed) {
+  EXPECT_NO_THROW(MakeDamage<2>());
+  auto all = Valid();
+  all.insert({{"zeta", 2}, {"eta", 0.1}, {"k", 0}});
+  const auto m = MakeDamage<3>(all);
+  EXPECT_EQ(m.name(), "damage");
+  EXPECT_EQ(m.state_size(), 2);
+  EXPECT_EQ(m.state_names(), (std::vector<std::string>{"damage", "dissipated"}));
+  EXPECT_DOUBLE_EQ(m.density(), kRho);
+}
+
+TEST(DamageParameters, InvalidValuesAreRejectedByName) {
+  const std::vector<std::pair<std::string, Real>>
+      bad = {{"sigma_crit", 0}, {"sigma_crit", -1}, {"eta", 0},  {"eta", -1e-3},
+             {"zeta", 0},       {"k", 1},           {"k", -0.1}, {"E", 0},
+             {"nu", 0.5},       {"density", -1},    {"l0", 0.1}};  // l0: the nonlocal length is not
+                                                                   // part of this local model
+  for (const auto& [key, value] : bad) ExpectRejected(With(key, value), key);
+  auto missing = Valid();
+  missing.erase("sigma_crit");
+  ExpectRejected(missing, "sigma_crit");
+}
+
+}  // namespace
+}  // namespace mpmtb
