@@ -65,3 +65,40 @@ INSTANTIATE_TEST_SUITE_P(Walls, Collider, ::testing::Values("sticky", "slip", "s
 
 }  // namespace
 }  // namespace mpmtb
+
+namespace mpmtb {
+namespace {
+
+// With the damage model, the sheet tears where the ball passes. The ball also
+// drags the sheet against its pinned edge, which may tear there too; damage
+// anywhere else would be spurious, and most of it must be on the path.
+TEST(PinnedSheet, DamageDevelopsAlongTheBallsPath) {
+  std::string toml = sheet("sticky");
+  toml.replace(toml.find("model = \"neo-hookean\""), 21, "model = \"damage\"\nsigma_crit = 3e3");
+  const Scene scene = testing::scene_from_toml(toml);
+  State<2> s = build_state<2>(scene);
+  Parameters params;
+  auto st = make_stepper<2>("mls", "quadratic", params);
+  for (int i = 0; i < 1000; ++i) st->step(s, 2e-4);
+  const SphereCollider& ball = scene.colliders[0];
+  const int slot = 0;  // "damage" is the first state variable
+  int on_path = 0, at_support = 0;
+  const Real support = scene.pins[0].min[1];
+  for (std::size_t p = 0; p < s.particles.size(); ++p) {
+    if (s.particles.state_of(p)[slot] < 0.5) continue;
+    // The ball moves along -x at height start.y: distance from that line.
+    const Real off_path = std::abs(s.particles.x[p][1] - ball.start[1]);
+    if (off_path < ball.radius + 3 * s.grid.geo.dx) {
+      ++on_path;
+    } else {
+      ++at_support;
+      EXPECT_GT(s.particles.x[p][1], support - 0.15) << "damage away from the path and the support";
+    }
+  }
+  EXPECT_GT(on_path, 2 * at_support) << "the ball must tear the sheet along its path";
+  EXPECT_LT(on_path + at_support, static_cast<int>(s.particles.size()) / 2)
+      << "damage must stay local";
+}
+
+}  // namespace
+}  // namespace mpmtb
