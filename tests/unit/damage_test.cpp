@@ -18,9 +18,15 @@
 #include "core/types.hpp"
 #include "models/damage.hpp"
 #include "models/neo_hookean.hpp"
+#include "support/finite_difference.hpp"
+#include "support/random_matrices.hpp"
 
 namespace mpmtb {
 namespace {
+
+using testing::FiniteDifferenceP;
+using testing::RandomMatrix;
+using testing::RandomRotation;
 
 constexpr Real kE = 250, kNu = 0.3, kRho = 7, kSigmaCrit = 20;
 // Lame constants derived here, independently of the class under test.
@@ -44,14 +50,6 @@ Damage<Dim> MakeDamage(const std::map<std::string, Real>& values = Valid()) {
   return m;
 }
 
-template <int Dim>
-Mat<Dim> RandomMatrix(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> u(-1, 1);
-  Mat<Dim> A;
-  for (int k = 0; k < Dim * Dim; ++k) A(k / Dim, k % Dim) = u(gen);
-  return A;
-}
-
 // F = I + 0.3 * random with J >= 0.2, and |J - 1| > 1e-3 so that the finite
 // differences do not straddle the tension/compression switch at J = 1.
 template <int Dim>
@@ -60,19 +58,6 @@ Mat<Dim> RandomF(std::mt19937& gen) {
     const Mat<Dim> F = Mat<Dim>::Identity() + 0.3 * RandomMatrix<Dim>(gen);
     const Real J = F.determinant();
     if (J >= 0.2 && std::abs(J - 1) > 1e-3) return F;
-  }
-}
-
-template <int Dim>
-Mat<Dim> RandomRotation(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> angle(-std::numbers::pi, std::numbers::pi);
-  if constexpr (Dim == 1) {
-    return Mat<Dim>::Identity();
-  } else if constexpr (Dim == 2) {
-    return Eigen::Rotation2D<Real>(angle(gen)).toRotationMatrix();
-  } else {
-    const Vec<3> axis = RandomMatrix<3>(gen).col(0).normalized();
-    return Eigen::AngleAxis<Real>(angle(gen), axis).toRotationMatrix();
   }
 }
 
@@ -108,20 +93,11 @@ TYPED_TEST_SUITE(DamageTest, Dims);
 TYPED_TEST(DamageTest, StressIsEnergyGradientAtFixedDamage) {
   constexpr int Dim = TestFixture::Dim;
   const ConstitutiveModel<Dim>& m = this->m_;
-  const Real h = 1e-6;
   for (const Real d : {0.0, 0.3, 1.0}) {
     const Real q[2] = {d, 0};
     for (int s = 0; s < 20; ++s) {
       const Mat<Dim> F = RandomF<Dim>(this->gen_);
-      Mat<Dim> P_fd;
-      for (int i = 0; i < Dim; ++i) {
-        for (int j = 0; j < Dim; ++j) {
-          Mat<Dim> Fp = F, Fm = F;
-          Fp(i, j) += h;
-          Fm(i, j) -= h;
-          P_fd(i, j) = (m.energy_density(Fp, q) - m.energy_density(Fm, q)) / (2 * h);
-        }
-      }
+      const Mat<Dim> P_fd = FiniteDifferenceP<Dim>(m, F, q);
       const Mat<Dim> P = m.first_piola(F, q);
       EXPECT_LT((P - P_fd).norm(), 1e-6 * (P.norm() + 1e-3 * kE)) << "d " << d << "\n" << F;
       const Mat<Dim> PFt = P * F.transpose();

@@ -23,9 +23,16 @@
 #include "core/particles.hpp"
 #include "models/fixed_corotated.hpp"
 #include "models/registry.hpp"
+#include "support/finite_difference.hpp"
+#include "support/random_matrices.hpp"
 
 namespace mpmtb {
 namespace {
+
+using testing::FiniteDifferenceP;
+using testing::RandomF;
+using testing::RandomMatrix;
+using testing::RandomRotation;
 
 constexpr Real kE = 250, kNu = 0.3, kRho = 7;
 // Lame constants derived here, independently of the code under test.
@@ -58,37 +65,6 @@ std::unique_ptr<ConstitutiveModel<Dim>> Make(const std::string& model) {
   return make_model<Dim>(model, p);
 }
 
-template <int Dim>
-Mat<Dim> RandomMatrix(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> u(-1, 1);
-  Mat<Dim> A;
-  for (int i = 0; i < Dim; ++i)
-    for (int j = 0; j < Dim; ++j) A(i, j) = u(gen);
-  return A;
-}
-
-// F = I + amplitude * random, with det F >= 0.2.
-template <int Dim>
-Mat<Dim> RandomF(std::mt19937& gen, Real amplitude = 0.3) {
-  for (;;) {
-    const Mat<Dim> F = Mat<Dim>::Identity() + amplitude * RandomMatrix<Dim>(gen);
-    if (F.determinant() >= 0.2) return F;
-  }
-}
-
-template <int Dim>
-Mat<Dim> RandomRotation(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> angle(-std::numbers::pi, std::numbers::pi);
-  if constexpr (Dim == 1) {
-    return Mat<Dim>::Identity();
-  } else if constexpr (Dim == 2) {
-    return Eigen::Rotation2D<Real>(angle(gen)).toRotationMatrix();
-  } else {
-    const Vec<3> axis = RandomMatrix<3>(gen).col(0).normalized();
-    return Eigen::AngleAxis<Real>(angle(gen), axis).toRotationMatrix();
-  }
-}
-
 // Particles of one material with the given F, V0 = 1 + p, initial state.
 template <int Dim>
 Particles<Dim> MakeParticles(const ConstitutiveModel<Dim>& m, const std::vector<Mat<Dim>>& Fs) {
@@ -106,21 +82,6 @@ std::vector<int> Ids(std::size_t n) {
   std::vector<int> ids(n);
   std::iota(ids.begin(), ids.end(), 0);
   return ids;
-}
-
-template <int Dim>
-Mat<Dim> FiniteDifferenceP(const ConstitutiveModel<Dim>& m, const Mat<Dim>& F, const Real* q) {
-  const Real h = 1e-6;
-  Mat<Dim> P_fd;
-  for (int i = 0; i < Dim; ++i) {
-    for (int j = 0; j < Dim; ++j) {
-      Mat<Dim> Fp = F, Fm = F;
-      Fp(i, j) += h;
-      Fm(i, j) -= h;
-      P_fd(i, j) = (m.energy_density(Fp, q) - m.energy_density(Fm, q)) / (2 * h);
-    }
-  }
-  return P_fd;
 }
 
 struct Case {

@@ -15,9 +15,16 @@
 #include "core/parameters.hpp"
 #include "core/types.hpp"
 #include "models/neo_hookean.hpp"
+#include "support/finite_difference.hpp"
+#include "support/random_matrices.hpp"
 
 namespace mpmtb {
 namespace {
+
+using testing::FiniteDifferenceP;
+using testing::RandomF;
+using testing::RandomMatrix;
+using testing::RandomRotation;
 
 constexpr Real kE = 250, kNu = 0.3, kRho = 7;
 // Lame constants derived here, independently of the class under test.
@@ -29,37 +36,6 @@ struct Fixture {
   Parameters params{"materials.test", {{"E", kE}, {"nu", kNu}, {"density", kRho}}};
   NeoHookean<Dim> model{params};
 };
-
-template <int Dim>
-Mat<Dim> RandomMatrix(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> u(-1, 1);
-  Mat<Dim> A;
-  for (int i = 0; i < Dim; ++i)
-    for (int j = 0; j < Dim; ++j) A(i, j) = u(gen);
-  return A;
-}
-
-// F = I + 0.3 * random, kept away from J <= 0 where the model is undefined.
-template <int Dim>
-Mat<Dim> RandomF(std::mt19937& gen) {
-  for (;;) {
-    const Mat<Dim> F = Mat<Dim>::Identity() + 0.3 * RandomMatrix<Dim>(gen);
-    if (F.determinant() >= 0.2) return F;
-  }
-}
-
-template <int Dim>
-Mat<Dim> RandomRotation(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> angle(-std::numbers::pi, std::numbers::pi);
-  if constexpr (Dim == 1) {
-    return Mat<Dim>::Identity();  // the only proper rotation in 1D
-  } else if constexpr (Dim == 2) {
-    return Eigen::Rotation2D<Real>(angle(gen)).toRotationMatrix();
-  } else {
-    const Vec<3> axis = RandomMatrix<3>(gen).col(0).normalized();
-    return Eigen::AngleAxis<Real>(angle(gen), axis).toRotationMatrix();
-  }
-}
 
 template <class D>
 class NeoHookeanTest : public ::testing::Test {
@@ -76,18 +52,9 @@ TYPED_TEST_SUITE(NeoHookeanTest, Dims);
 TYPED_TEST(NeoHookeanTest, StressIsEnergyGradient) {
   constexpr int Dim = TestFixture::Dim;
   const ConstitutiveModel<Dim>& m = this->f_.model;
-  const Real h = 1e-6;
   for (int s = 0; s < 20; ++s) {
     const Mat<Dim> F = RandomF<Dim>(this->gen_);
-    Mat<Dim> P_fd;
-    for (int i = 0; i < Dim; ++i) {
-      for (int j = 0; j < Dim; ++j) {
-        Mat<Dim> Fp = F, Fm = F;
-        Fp(i, j) += h;
-        Fm(i, j) -= h;
-        P_fd(i, j) = (m.energy_density(Fp, nullptr) - m.energy_density(Fm, nullptr)) / (2 * h);
-      }
-    }
+    const Mat<Dim> P_fd = FiniteDifferenceP<Dim>(m, F, nullptr);
     const Mat<Dim> P = m.first_piola(F, nullptr);
     EXPECT_LT((P - P_fd).norm(), 1e-6 * P.norm()) << "F =\n" << F << "\nP =\n" << P;
     EXPECT_EQ(P, this->f_.model.P(F, nullptr)) << "first_piola differs from P";

@@ -15,31 +15,15 @@
 #include <vector>
 
 #include "models/polar.hpp"
+#include "support/random_matrices.hpp"
 
 namespace mpmtb {
 namespace {
 
+using testing::RandomMatrix;
+using testing::RandomRotation;
+
 constexpr Real kTol = 1e-12;
-
-template <int Dim>
-Mat<Dim> RandomMatrix(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> u(-1, 1);
-  Mat<Dim> A;
-  for (int i = 0; i < Dim; ++i)
-    for (int j = 0; j < Dim; ++j) A(i, j) = u(gen);
-  return A;
-}
-
-template <int Dim>
-Mat<Dim> RandomRotation(std::mt19937& gen, Real max_angle = std::numbers::pi) {
-  std::uniform_real_distribution<Real> angle(-max_angle, max_angle);
-  if constexpr (Dim == 2) {
-    return Eigen::Rotation2D<Real>(angle(gen)).toRotationMatrix();
-  } else {
-    const Vec<3> axis = RandomMatrix<3>(gen).col(0).normalized();
-    return Eigen::AngleAxis<Real>(angle(gen), axis).toRotationMatrix();
-  }
-}
 
 template <int Dim>
 Mat<Dim> Reflection() {

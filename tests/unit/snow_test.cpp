@@ -15,24 +15,18 @@
 #include "core/parameters.hpp"
 #include "models/fixed_corotated.hpp"
 #include "models/snow.hpp"
+#include "support/random_matrices.hpp"
 
 namespace mpmtb {
 namespace {
+
+using testing::RandomMatrix;
 
 constexpr Real kE = 250, kNu = 0.3, kRho = 7;
 constexpr Real kThetaC = 2.5e-2, kThetaS = 7.5e-3, kXi = 10;  // the paper's reference snow
 
 std::map<std::string, Real> Elastic(Real E = kE) {
   return {{"E", E}, {"nu", kNu}, {"density", kRho}};
-}
-
-template <int Dim>
-Mat<Dim> RandomMatrix(std::mt19937& gen) {
-  std::uniform_real_distribution<Real> u(-1, 1);
-  Mat<Dim> A;
-  for (int i = 0; i < Dim; ++i)
-    for (int j = 0; j < Dim; ++j) A(i, j) = u(gen);
-  return A;
 }
 
 // A large deformation: F = I + 0.5 * random with det F >= 0.1.
