@@ -15,7 +15,7 @@ Diagnostics measure(const State<Dim>& s, const Stepper<Dim>& stepper) {
   for (std::size_t p = 0; p < P.size(); ++p) {
     const Vec3 x = to3<Dim>(P.x[p]);
     const Vec3 mv = P.m[p] * to3<Dim>(P.v[p]);
-    const Real J = P.F[p].determinant();
+    const Real J = s.materials[P.material[p]]->total_J(P.F[p], P.state_of(p));
     d.mass += P.m[p];
     d.kinetic += Real(0.5) * P.m[p] * P.v[p].squaredNorm();
     d.gravity -= P.m[p] * s.gravity.dot(P.x[p]);

@@ -33,6 +33,9 @@ class ConstitutiveModel {
   // Per-particle formulas, for tests and diagnostics.
   virtual Real energy_density(const Mat<Dim>& F, const Real* q) const = 0;   // psi(F)
   virtual Mat<Dim> first_piola(const Mat<Dim>& F, const Real* q) const = 0;  // P = dpsi/dF
+  // Volume ratio of the total deformation: det F, or J_E J_P when F_p holds
+  // only the elastic part (plasticity). Used for the reported volume and J range.
+  virtual Real total_J(const Mat<Dim>& F, const Real* /*q*/) const { return F.determinant(); }
 
   // Batches over the particles `ids` of this material.
   // tauV[p] = V0_p * tau(F_p), tau = P F^T the Kirchhoff stress.

@@ -67,6 +67,8 @@ class Snow final : public ModelBase<Dim, Snow<Dim>> {
     q[kDissipated] = 0;
   }
   std::vector<std::string> state_names() const override { return {"J_P", "dissipated"}; }
+  // F_p is F_E: the total volume ratio is J = J_E J_P.
+  Real total_J(const Mat<Dim>& F, const Real* q) const override { return F.determinant() * q[0]; }
 
   Real theta_c() const { return theta_c_; }
   Real theta_s() const { return theta_s_; }

@@ -14,6 +14,7 @@
 
 #include "core/parameters.hpp"
 #include "models/fixed_corotated.hpp"
+#include "models/registry.hpp"
 #include "models/snow.hpp"
 #include "support/random_matrices.hpp"
 
@@ -206,6 +207,32 @@ TEST(SnowModel, ClampCanRaiseStoredEnergyAndTheBudgetStillCloses) {
   };
   check(snow1, Mat<1>(Mat<1>::Constant(0.3)));
   check(snow3, Mat<3>(Vec<3>(1.0175, 0.976, 0.976).asDiagonal()));
+}
+
+}  // namespace
+}  // namespace mpmtb
+
+namespace mpmtb {
+namespace {
+
+// The reported volume ratio is the total J = J_E J_P, not the elastic part.
+TEST(SnowVolume, TotalJIncludesThePlasticPart) {
+  Parameters p("materials.snow", {{"E", 250}, {"nu", 0.3}, {"density", 7}});
+  const auto m = make_model<3>("snow", p);
+  std::vector<Real> q(m->state_size());
+  m->initial_state(q.data());
+  Mat<3> F = 0.8 * Mat<3>::Identity();  // far outside the clamp: plastic compression
+  const Real J_trial = F.determinant();
+  Particles<3> P;
+  P.state_size = m->state_size();
+  P.add(Vec<3>::Zero(), Vec<3>::Zero(), 1, 1, 0);
+  P.F[0] = F;
+  std::copy(q.begin(), q.end(), P.state.begin());
+  const std::vector<int> ids = {0};
+  m->return_map(P, ids, 1e-3);
+  EXPECT_LT(std::abs(P.F[0].determinant() - J_trial), 1) << "the clamp must act";
+  EXPECT_GT(std::abs(P.F[0].determinant() - J_trial), 1e-3) << "the clamp must act";
+  EXPECT_NEAR(m->total_J(P.F[0], P.state_of(0)), J_trial, 1e-12);
 }
 
 }  // namespace
