@@ -14,9 +14,9 @@ template <int Dim>
 class ExtraColumns {
  public:
   explicit ExtraColumns(const State<Dim>& s) {
-    boundary_ = !s.colliders.empty() ||
-                std::any_of(s.particles.pinned.begin(), s.particles.pinned.end(),
-                            [](auto p) { return p != 0; });
+    boundary_ =
+        !s.colliders.empty() || std::any_of(s.particles.pinned.begin(), s.particles.pinned.end(),
+                                            [](auto p) { return p != 0; });
     for (const auto& m : s.materials) {
       const auto names = m->state_names();
       const auto it = std::find(names.begin(), names.end(), "damage");
@@ -29,7 +29,7 @@ class ExtraColumns {
     std::vector<std::string> n;
     if (boundary_) {
       n = {"collider_impulse_x", "collider_impulse_y", "collider_impulse_z", "pin_impulse_x",
-           "pin_impulse_y",      "pin_impulse_z",      "collider_work",     "penetration"};
+           "pin_impulse_y",      "pin_impulse_z",      "collider_work",      "penetration"};
     }
     if (damage_) n.push_back("damaged_fraction");
     return n;

@@ -30,9 +30,11 @@ void Colliders<Dim>::apply(Grid<Dim>& grid, Real t, Vec3& total_impulse, Real& w
     std::array<int, Dim> lo{}, hi{};
     bool inside_grid = true;
     for (int a = 0; a < Dim; ++a) {
-      lo[a] = std::max(0, static_cast<int>(std::floor((center[a] - c.radius - geo.lo[a]) / geo.dx)) + pad);
-      hi[a] = std::min(geo.nodes(a) - 1,
-                       static_cast<int>(std::ceil((center[a] + c.radius - geo.lo[a]) / geo.dx)) + pad);
+      lo[a] = std::max(
+          0, static_cast<int>(std::floor((center[a] - c.radius - geo.lo[a]) / geo.dx)) + pad);
+      hi[a] =
+          std::min(geo.nodes(a) - 1,
+                   static_cast<int>(std::ceil((center[a] + c.radius - geo.lo[a]) / geo.dx)) + pad);
       inside_grid = inside_grid && lo[a] <= hi[a];
     }
     if (!inside_grid) continue;

@@ -72,7 +72,8 @@ class Solver final : public Stepper<Dim> {
     }
     s.pin_impulse += Vec3(rx, ry, rz);
     s.walls.apply(g);
-    if (!s.colliders.empty()) s.colliders.apply(g, s.time + dt, s.collider_impulse, s.collider_work);
+    if (!s.colliders.empty())
+      s.colliders.apply(g, s.time + dt, s.collider_impulse, s.collider_work);
   }
 
   StepReport grid_to_particles(State<Dim>& s, Real dt) override {
