@@ -77,8 +77,6 @@ void read_time(TableReader& top, Scene& s) {
   TableReader t(top.table("time"), "time");
   s.t_end = t.number("t_end", Range::positive());
   if (t.has("dt") == t.has("cfl")) {
-    t.number_or("dt", 0, Range::any());
-    t.number_or("cfl", 0, Range::any());
     throw InputError("time: give exactly one of 'dt' (fixed step) or 'cfl' (adaptive step)");
   }
   if (t.has("dt")) s.dt = t.number("dt", Range::positive());

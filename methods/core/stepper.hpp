@@ -1,7 +1,7 @@
 // The common step interface: one compiled combination of dimension, kernel and
 // transfer scheme. The stages follow the textbook pipeline:
 //   P2G (mass, momentum, internal force) -> grid update (divide by mass, gravity,
-//   walls, pinned nodes) -> G2P (v, C, F, x) -> constitutive return map.
+//   walls, pinned nodes, colliders) -> G2P (v, C, F, x) -> constitutive return map.
 // One virtual call per stage; everything inside is monomorphic.
 #pragma once
 
