@@ -1,13 +1,14 @@
 #include "references/reference.hpp"
 
 #include "models/registry.hpp"
+#include "references/manufactured.hpp"
 #include "references/vibrating_bar.hpp"
 #include "scene.hpp"
 
 namespace mpmtb {
 
 std::vector<std::string> reference_kinds() {
-  return {"vibrating-bar"};
+  return {"vibrating-bar", "mms-bar", "mms-axis"};
 }
 
 template <int Dim>
@@ -18,6 +19,9 @@ std::unique_ptr<Reference<Dim>> make_reference(const Scene& scene) {
     Parameters params = m.params;
     const Real c = make_model<Dim>(m.model, params)->wave_speed();
     return std::make_unique<VibratingBar<Dim>>(scene, c);
+  }
+  if (scene.reference == "mms-bar" || scene.reference == "mms-axis") {
+    return std::make_unique<ManufacturedReference<Dim>>(scene, scene.reference);
   }
   return nullptr;  // unreachable: read_scene accepts only reference_kinds()
 }
