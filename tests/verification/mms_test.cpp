@@ -19,56 +19,17 @@
 //   point method", IJNME 76); the B-splines' error falls.
 #include <gtest/gtest.h>
 
-#include <fmt/format.h>
-
-#include <cmath>
 #include <cstdio>
-#include <filesystem>
-#include <limits>
 #include <tuple>
 
-#include "run.hpp"
+#include "support/convergence.hpp"
 
 namespace mpmtb {
 namespace {
 
-// The error of one run; +inf for an unstable run (it counts as "not falling").
-Real mms_error(const std::string& scene_name, Overrides o) {
-  const Scene scene = load_scene(scene_name, o);
-  const auto dir =
-      std::filesystem::temp_directory_path() /
-      fmt::format("mpmtb_mms_{}_{}d_{}_{}_{}_{}", scene.name, scene.dim, scene.transfer,
-                  scene.kernel, scene.cells, o.set.empty() ? "default" : "set");
-  const RunOutcome r = run_scene(scene, dir, {.threads = 1});
-  if (r.status != "ok") return std::numeric_limits<Real>::infinity();
-  return r.summary["error"]["disp_l2"].get<Real>();
-}
-
-std::vector<Real> errors_over(const std::string& scene, const std::vector<int>& levels,
-                              Overrides o) {
-  std::vector<Real> e;
-  for (const int n : levels) {
-    o.cells = n;
-    e.push_back(mms_error(scene, o));
-  }
-  return e;
-}
-
-std::vector<Real> orders_of(const std::vector<Real>& e) {
-  std::vector<Real> r;
-  for (std::size_t k = 1; k < e.size(); ++k) r.push_back(std::log2(e[k - 1] / e[k]));
-  return r;
-}
-
-std::string table(const std::vector<int>& levels, const std::vector<Real>& e) {
-  std::string s;
-  for (std::size_t k = 0; k < e.size(); ++k) {
-    s += fmt::format("{} cells: {:.3e}", levels[k], e[k]);
-    if (k > 0) s += fmt::format(" (order {:.2f})", std::log2(e[k - 1] / e[k]));
-    s += "\n";
-  }
-  return s;
-}
+using testing::error_table;
+using testing::errors_over;
+using testing::orders_of;
 
 const std::vector<std::string> kLarge = {"reference.amplitude=0.05"};
 
@@ -90,10 +51,10 @@ TEST_P(SmallBar, ConvergesAtSecondOrder) {
   const std::vector<int> levels = {8, 16, 32, 64};
   const auto e = errors_over("mms_bar", levels, {.transfer = transfer, .kernel = kernel});
   for (const Real order : orders_of(e)) {
-    EXPECT_GE(order, 1.7) << table(levels, e);
-    EXPECT_LE(order, 2.4) << table(levels, e);
+    EXPECT_GE(order, 1.7) << error_table(levels, e);
+    EXPECT_LE(order, 2.4) << error_table(levels, e);
   }
-  std::printf("%s", table(levels, e).c_str());
+  std::printf("%s", error_table(levels, e).c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(AllKernels, SmallBar,
@@ -106,8 +67,8 @@ TEST(SmallBarPic, ConvergesAtFirstOrderOnly) {
     const std::vector<int> levels = {16, 32, 64};
     const auto e = errors_over("mms_bar", levels, {.transfer = "pic", .kernel = kernel});
     for (const Real order : orders_of(e)) {
-      EXPECT_GE(order, 0.5) << kernel << "\n" << table(levels, e);
-      EXPECT_LE(order, 1.3) << kernel << "\n" << table(levels, e);
+      EXPECT_GE(order, 0.5) << kernel << "\n" << error_table(levels, e);
+      EXPECT_LE(order, 1.3) << kernel << "\n" << error_table(levels, e);
     }
   }
 }
@@ -121,8 +82,8 @@ TEST_P(LargeBarLinear, ErrorDoesNotKeepFalling) {
   const std::vector<int> levels = {8, 16, 32, 64};
   const auto e =
       errors_over("mms_bar", levels, {.transfer = GetParam(), .kernel = "linear", .set = kLarge});
-  EXPECT_TRUE(std::isinf(e[3]) || e[3] > e[2]) << table(levels, e);
-  std::printf("%s", table(levels, e).c_str());
+  EXPECT_TRUE(std::isinf(e[3]) || e[3] > e[2]) << error_table(levels, e);
+  std::printf("%s", error_table(levels, e).c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(AllTransfers, LargeBarLinear,
@@ -141,8 +102,8 @@ TEST_P(LargeBarBSpline, ErrorFalls) {
       errors_over("mms_bar", levels, {.transfer = transfer, .kernel = kernel, .set = kLarge});
   // PIC: first order, approached from below (~0.5 between 8 and 16 cells).
   const Real lowest = transfer == "pic" ? 0.3 : 1.7;
-  for (const Real order : orders_of(e)) EXPECT_GE(order, lowest) << table(levels, e);
-  std::printf("%s", table(levels, e).c_str());
+  for (const Real order : orders_of(e)) EXPECT_GE(order, lowest) << error_table(levels, e);
+  std::printf("%s", error_table(levels, e).c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(AllTransfers, LargeBarBSpline,
@@ -162,10 +123,10 @@ TEST_P(AxisAligned2D, ConvergesAtSecondOrder) {
   const auto e =
       errors_over("mms_axis", levels, {.dim = 2, .transfer = transfer, .kernel = kernel});
   for (const Real order : orders_of(e)) {
-    EXPECT_GE(order, 1.7) << table(levels, e);
-    EXPECT_LE(order, 2.4) << table(levels, e);
+    EXPECT_GE(order, 1.7) << error_table(levels, e);
+    EXPECT_LE(order, 2.4) << error_table(levels, e);
   }
-  std::printf("%s", table(levels, e).c_str());
+  std::printf("%s", error_table(levels, e).c_str());
 }
 
 INSTANTIATE_TEST_SUITE_P(BSplines, AxisAligned2D,
