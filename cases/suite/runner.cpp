@@ -24,6 +24,11 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kMarker = "done.json";
+#ifdef MPMTB_GIT_REV
+constexpr const char* kRevision = MPMTB_GIT_REV;
+#else
+constexpr const char* kRevision = "unknown";
+#endif
 
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop_signal(int) {
@@ -172,6 +177,8 @@ RunResult settle(const RunSpec& spec, const fs::path& dir, int wait_status, bool
   const bool exited = WIFEXITED(wait_status);
   const int code = exited ? WEXITSTATUS(wait_status) : -1;
   nlohmann::json marker;
+  marker["arguments"] = spec.arguments(dir);
+  marker["revision"] = kRevision;
   marker["seconds"] = seconds;
   if (exited) {
     marker["exit_code"] = code;
@@ -214,9 +221,15 @@ RunResult settle(const RunSpec& spec, const fs::path& dir, int wait_status, bool
   return r;
 }
 
-std::optional<RunResult> finished(const fs::path& dir) {
+// A finished run: its marker exists and records the same arguments and git
+// revision (a run left by an earlier suite definition or build is redone).
+std::optional<RunResult> finished(const RunSpec& spec, const fs::path& dir) {
   auto marker = read_json(dir / kMarker);
   if (!marker || !marker->contains("status")) return std::nullopt;
+  if (marker->value("arguments", nlohmann::json()) != nlohmann::json(spec.arguments(dir)) ||
+      marker->value("revision", "") != kRevision) {
+    return std::nullopt;
+  }
   auto summary = read_json(dir / "summary.json");
   if (!summary) return std::nullopt;
   return RunResult{marker->value("status", ""), marker->value("reason", ""), *summary};
@@ -241,7 +254,7 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
   std::vector<RunResult> results(specs.size());
   std::deque<std::size_t> pending;
   for (std::size_t i = 0; i < specs.size(); ++i) {
-    if (auto r = finished(root / specs[i].dir)) {
+    if (auto r = finished(specs[i], root / specs[i].dir)) {
       results[i] = std::move(*r);
     } else {
       pending.push_back(i);

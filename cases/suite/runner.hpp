@@ -4,8 +4,10 @@
 // the completion marker, written last and atomically after the child has
 // exited and its summary.json is final. A later call skips finished runs, so
 // a suite killed at any moment (even by SIGKILL) resumes where it stopped and
-// redoes only the unfinished runs. A child that crashes or hangs is a data
-// point (status `crashed`), never a crash of the suite.
+// redoes only the unfinished runs. The marker records the run's arguments and
+// the git revision of the build; a run whose definition or revision has changed
+// since is redone (uncommitted changes do not count: remove the folder then). A child that crashes
+// or hangs is a data point (status `crashed`), never a crash of the suite.
 #pragma once
 
 #include <nlohmann/json.hpp>
