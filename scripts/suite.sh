@@ -3,7 +3,8 @@
 # its quick default and regenerates the figures and results/README.md.
 # Every transfer x kernel on the vibrating bar (1D, 2D, 3D), the colliding
 # disks (2D) and spheres (3D) and the free rotating body (2D, 3D); the pinned
-# block struck by a ball (3D, damage) with MLS-MPM and every kernel.
+# block struck by a ball (3D, damage) with MLS-MPM and every kernel; then the
+# quick suites and the figures.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/build.sh
@@ -22,5 +23,8 @@ sweep rotating 3
 # The pinned block (32,768 particles, damage): one method, about a minute.
 rm -rf results/pinned_block/3d
 "$mpmtb" run pinned_block --transfer mls --kernel all --out results/pinned_block/3d || [ $? -eq 3 ]
+# The suites (convergence, stability, speed-accuracy) at the quick level: every
+# transfer x kernel, one run per child process, resumable (results/suites).
+"$mpmtb" suite all --quick --out results/suites
 /usr/bin/python3 analysis/plot_all.py --results results
 echo "mpmtb: results in results/README.md"

@@ -6,6 +6,13 @@ mpmtb=$1 source_dir=$2 work=$3
 rm -rf "$work" && mkdir -p "$work/bar"
 "$mpmtb" run bar --transfer all --kernel all --t-end 2 --out "$work/bar/1d" 2>/dev/null
 "$mpmtb" run bar --dim 2 --kernel quadratic --transfer all --t-end 2 --out "$work/bar/2d" 2>/dev/null
+# Small suites: every figure kind of the suites (convergence and dt
+# refinement, stability map, failure modes, Pareto and throughput).
+"$mpmtb" suite convergence --case bar --kernel quadratic --kernel cubic --transfer mls \
+  --transfer pic --quiet --out "$work/suites"
+"$mpmtb" suite stability --case bar_fixed --case translate --transfer mls --kernel linear \
+  --kernel cubic --quiet --out "$work/suites"
+"$mpmtb" suite speed-accuracy --transfer apic --kernel quadratic --quiet --out "$work/suites"
 /usr/bin/python3 "$source_dir/analysis/plot_all.py" --results "$work"
 test -s "$work/README.md"
 figures=$(grep -o '([^)]*\.png)' "$work/README.md" | tr -d '()')
@@ -13,6 +20,13 @@ figures=$(grep -o '([^)]*\.png)' "$work/README.md" | tr -d '()')
 for f in $figures; do
   head -c 8 "$work/$f" | od -An -tx1 | grep -q "89 50 4e 47" || { echo "not a PNG: $f"; exit 1; }
 done
+for f in suites/convergence/bar.png suites/convergence/bar_dt.png \
+  suites/stability/stability_map.png suites/stability/failure_modes.png \
+  suites/speed_accuracy/bar_2d_pareto.png suites/speed_accuracy/throughput.png; do
+  grep -q "($f)" "$work/README.md" || { echo "$f missing from the index"; exit 1; }
+done
+grep -q "### Observed orders" "$work/README.md" || { echo "no orders table"; exit 1; }
+grep -q "### Largest stable CFL" "$work/README.md" || { echo "no stability table"; exit 1; }
 for run in $("$mpmtb" list transfers); do
   grep -q "$run-linear" "$work/README.md" || { echo "$run-linear missing from the index"; exit 1; }
 done

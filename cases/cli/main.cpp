@@ -6,6 +6,7 @@
 
 #include "commands.hpp"
 #include "core/errors.hpp"
+#include "suite/suite.hpp"
 
 namespace {
 
@@ -24,6 +25,24 @@ void add_override_options(CLI::App& cmd, mpmtb::Overrides& o) {
   cfl->excludes(dt);
   cmd.add_option("--t-end", o.t_end, "end time");
   cmd.add_option("--set", o.set, "override any scene field: key.path=value (repeatable)");
+}
+
+// `mpmtb suite ...`: resumable parallel sweeps (cases/suite/).
+CLI::App* add_suite_command(CLI::App& app, mpmtb::SuiteRequest& r) {
+  auto* cmd = app.add_subcommand("suite", "run a suite of runs and write its tables");
+  cmd->add_option("name", r.name, "convergence | stability | speed-accuracy | all")
+      ->required()
+      ->check(CLI::IsMember({"convergence", "stability", "speed-accuracy", "all"}));
+  auto* quick = cmd->add_flag("--quick")->description("the quick levels (default)");
+  cmd->add_flag("--full", r.full, "the full levels, for real studies")->excludes(quick);
+  cmd->add_option("--jobs", r.jobs, "runs at once, each with one thread (default: cores)")
+      ->check(CLI::PositiveNumber);
+  cmd->add_option("--out", r.out, "output folder (default results/suites)");
+  cmd->add_flag("--quiet", r.quiet, "no progress on stderr");
+  cmd->add_option("--case", r.cases, "only these cases (repeatable)");
+  cmd->add_option("--transfer", r.transfers, "only these transfers (repeatable)");
+  cmd->add_option("--kernel", r.kernels, "only these kernels (repeatable)");
+  return cmd;
 }
 
 }  // namespace
@@ -51,6 +70,9 @@ int main(int argc, char** argv) {
   describe->add_option("scene", describe_scene, "built-in scene name or scene file")->required();
   add_override_options(*describe, describe_overrides);
 
+  mpmtb::SuiteRequest suite_request;
+  auto* suite = add_suite_command(app, suite_request);
+
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -60,6 +82,7 @@ int main(int argc, char** argv) {
   try {
     if (*list) return mpmtb::command_list(list_only);
     if (*describe) return mpmtb::command_describe(describe_scene, describe_overrides);
+    if (*suite) return mpmtb::command_suite(suite_request);
     return mpmtb::command_run(run_request);
   } catch (const mpmtb::InputError& e) {
     fmt::print(stderr, "mpmtb: invalid input: {}\n", e.what());

@@ -1,0 +1,308 @@
+"""Figures from the tables of `mpmtb suite` (results/suites by default).
+
+Every function takes the suite folder, draws what its tables hold and
+returns the written PNG paths (empty when the table is absent):
+
+  convergence/<case>.png      log-log error against h per kernel, one line per
+                              transfer, reference slopes 1 and 2
+  convergence/<case>_dt.png   the same against dt at a fixed grid
+  stability/stability_map.png largest stable CFL per method and case x ppc
+  stability/failure_modes.png the failure-mode metrics per method
+  speed_accuracy/<case>_pareto.png  error against wall time and particle-steps,
+                              Pareto front in black
+  speed_accuracy/throughput.png     particle-steps per second per method
+"""
+import glob
+import os
+
+import numpy as np
+
+import mpmtb_plots as mp
+
+plt = mp.plt
+
+
+def read_rows(path):
+    """Rows of a suite table, or [] when it does not exist."""
+    if not os.path.isfile(path):
+        return []
+    return mp.read_table(path)[1]
+
+
+def num(row, key):
+    """A table cell as float; empty or absent is nan."""
+    try:
+        return mp.parse_float(row.get(key, ""))
+    except ValueError:
+        return np.nan
+
+
+def ordered(names, known):
+    """Unique names, the known ones first in canonical order."""
+    unique = list(dict.fromkeys(names))
+    return sorted(unique, key=lambda n: (known.index(n) if n in known
+                                         else len(known), n))
+
+
+def method_name(row):
+    return f"{row['transfer']}-{row['kernel']}"
+
+
+def methods_of(rows):
+    pairs = {(r["transfer"], r["kernel"]) for r in rows}
+    return sorted(pairs, key=lambda p: (
+        mp.TRANSFERS.index(p[0]) if p[0] in mp.TRANSFERS else 99,
+        mp.KERNELS.index(p[1]) if p[1] in mp.KERNELS else 99, p))
+
+
+# ---------------------------------------------------------- convergence --
+
+def reference_slopes(ax, xs, ys):
+    """Dashed lines of slope 1 and 2 through the finest points' geometric mean."""
+    x0, x1 = min(xs), max(xs)
+    finest = [y for x, y in zip(xs, ys) if x == x0]
+    y0 = float(np.exp(np.mean(np.log(finest))))
+    for slope, style in ((1, ":"), (2, "--")):
+        x = np.array([x0, x1])
+        ax.plot(x, y0 * (x / x0) ** slope, color="black", linestyle=style,
+                linewidth=1.0, label=f"slope {slope}")
+
+
+def plot_convergence_table(path, xkey, xlabel):
+    rows = read_rows(path)
+    kernels = ordered([r["kernel"] for r in rows], mp.KERNELS)
+    if not kernels:
+        return []
+    case = os.path.basename(path)[:-4]
+    fig, axes = plt.subplots(1, len(kernels), squeeze=False, sharey=True,
+                             figsize=(3.6 * len(kernels) + 1.6, 3.8))
+    drawn = False
+    for ax, kernel in zip(axes[0], kernels):
+        xs_all, ys_all = [], []
+        transfers = ordered([r["transfer"] for r in rows
+                             if r["kernel"] == kernel], mp.TRANSFERS)
+        for transfer in transfers:
+            pts = [(num(r, xkey), num(r, "error")) for r in rows
+                   if r["kernel"] == kernel and r["transfer"] == transfer]
+            pts = [(x, y) for x, y in pts if x > 0 and y > 0]
+            if not pts:
+                continue
+            x, y = zip(*pts)
+            ax.plot(x, y, marker="o", markersize=3.5, label=transfer,
+                    **mp.line_style(transfer, kernel))
+            xs_all += x
+            ys_all += y
+        if xs_all:
+            reference_slopes(ax, xs_all, ys_all)
+            ax.set_xscale("log")
+            ax.set_yscale("log")
+            drawn = True
+        ax.set_title(kernel)
+        ax.set_xlabel(xlabel)
+        ax.grid(True, which="both", alpha=0.3)
+    if not drawn:
+        plt.close(fig)
+        return []
+    axes[0][0].set_ylabel("error")
+    fig.suptitle(f"convergence: {case} (ok runs; missing points are "
+                 "unstable runs)")
+    mp.legend_outside(fig, axes[0][-1])
+    out = path[:-4] + ".png"
+    mp.save_figure(fig, out)
+    return [out]
+
+
+def plot_convergence(suites):
+    out = []
+    for path in sorted(glob.glob(os.path.join(suites, "convergence", "*.csv"))):
+        name = os.path.basename(path)
+        if name == "orders.csv":
+            continue
+        if name.endswith("_dt.csv"):
+            out += plot_convergence_table(path, "dt", "time step dt (fixed grid)")
+        else:
+            out += plot_convergence_table(path, "h", "cell size h (dt ~ h)")
+    return out
+
+
+# ------------------------------------------------------------ stability --
+
+def plot_stability_map(suites):
+    path = os.path.join(suites, "stability", "stable_cfl.csv")
+    rows = read_rows(path)
+    if not rows:
+        return []
+    methods = methods_of(rows)
+    columns = list(dict.fromkeys((r["case"], r["ppc"]) for r in rows))
+    grid = np.full((len(methods), len(columns)), np.nan)
+    for r in rows:
+        i = methods.index((r["transfer"], r["kernel"]))
+        grid[i, columns.index((r["case"], r["ppc"]))] = num(r, "stable_cfl")
+    fig, ax = plt.subplots(figsize=(1.3 + 0.9 * len(columns),
+                                    1.2 + 0.38 * len(methods)))
+    image = ax.imshow(np.ma.masked_invalid(grid), cmap="viridis",
+                      aspect="auto")
+    for i in range(len(methods)):
+        for j in range(len(columns)):
+            text = "-" if np.isnan(grid[i, j]) else f"{grid[i, j]:.2f}"
+            ax.text(j, i, text, ha="center", va="center", fontsize=8,
+                    color="white" if np.nan_to_num(grid[i, j]) <
+                    np.nanmean(grid) else "black")
+    ax.set_xticks(range(len(columns)),
+                  [f"{c}\nppc {p}" for c, p in columns], fontsize=8)
+    ax.set_yticks(range(len(methods)), [f"{t}-{k}" for t, k in methods])
+    estimates = {}
+    for r in rows:
+        estimates[r["kernel"]] = (r["vn_low"], r["vn_high"])
+    note = ", ".join(f"{k} {lo}" + ("" if lo == hi else f"-{hi}")
+                     for k, (lo, hi) in estimates.items())
+    ax.set_title(f"largest stable CFL (von Neumann: {note})", fontsize=9)
+    fig.colorbar(image, ax=ax, label="CFL")
+    fig.tight_layout()
+    out = os.path.join(suites, "stability", "stability_map.png")
+    mp.save_figure(fig, out)
+    return [out]
+
+
+METRIC_LABELS = {
+    "strain_max_rel": "max strain energy / E0",
+    "energy_kept": "energy kept E(end)/E0",
+    "L_change": "|L - L0| / |L0|",
+}
+
+
+def plot_failure_modes(suites):
+    rows = read_rows(os.path.join(suites, "stability", "failure_modes.csv"))
+    cases = list(dict.fromkeys(r["case"] for r in rows))
+    if not cases:
+        return []
+    methods = methods_of(rows)
+    fig, axes = plt.subplots(1, len(cases), squeeze=False,
+                             figsize=(3.2 * len(cases) + 0.6,
+                                      1.2 + 0.3 * len(methods)))
+    for ax, case in zip(axes[0], cases):
+        by_method = {(r["transfer"], r["kernel"]): r for r in rows
+                     if r["case"] == case}
+        values = [num(by_method[m], "value") if m in by_method else np.nan
+                  for m in methods]
+        floor = 1e-17
+        log = mp.spans_decades(values)
+        for i, (m, v) in enumerate(zip(methods, values)):
+            if np.isfinite(v):
+                ax.barh(i, max(abs(v), floor) if log else v,
+                        **mp.bar_style(*m))
+            else:
+                status = by_method.get(m, {}).get("status", "missing")
+                ax.text(0.02, i, status, va="center", fontsize=7,
+                        transform=ax.get_yaxis_transform(), color="red")
+        if log:
+            ax.set_xscale("log")
+        ax.set_yticks(range(len(methods)), [f"{t}-{k}" for t, k in methods],
+                      fontsize=8)
+        ax.invert_yaxis()
+        metric = next(r["metric"] for r in rows if r["case"] == case)
+        ax.set_xlabel(METRIC_LABELS.get(metric, metric), fontsize=8)
+        ax.set_title(case, fontsize=9)
+        ax.grid(True, axis="x", alpha=0.3)
+    fig.suptitle("failure modes shown on purpose")
+    fig.tight_layout()
+    out = os.path.join(suites, "stability", "failure_modes.png")
+    mp.save_figure(fig, out)
+    return [out]
+
+
+# ------------------------------------------------------- speed-accuracy --
+
+def plot_pareto(path):
+    rows = [r for r in read_rows(path) if r["status"] == "ok"
+            and num(r, "error") > 0 and num(r, "wall_seconds") > 0]
+    if not rows:
+        return []
+    case = os.path.basename(path)[:-4]
+    fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2), sharey=True)
+    for ax, cost, flag, label in (
+            (axes[0], "wall_seconds", "pareto_time", "wall time [s]"),
+            (axes[1], "particle_steps", "pareto_work", "particle-steps")):
+        for transfer, kernel in methods_of(rows):
+            pts = sorted((num(r, cost), num(r, "error")) for r in rows
+                         if (r["transfer"], r["kernel"]) == (transfer, kernel))
+            x, y = zip(*pts)
+            ax.plot(x, y, marker="o", markersize=3.5,
+                    label=f"{transfer}-{kernel}",
+                    **mp.line_style(transfer, kernel))
+        front = sorted((num(r, cost), num(r, "error")) for r in rows
+                       if r[flag] == "1")
+        if front:
+            x, y = zip(*front)
+            ax.step(x, y, where="post", color="black", linewidth=1.0)
+            ax.scatter(x, y, s=60, facecolors="none", edgecolors="black",
+                       label="Pareto front", zorder=3)
+        ax.set_xscale("log")
+        ax.set_yscale("log")
+        ax.set_xlabel(label)
+        ax.grid(True, which="both", alpha=0.3)
+    axes[0].set_ylabel("error")
+    fig.suptitle(f"speed against accuracy: {case} (one thread per run)")
+    mp.legend_outside(fig, axes[1])
+    out = path[:-4] + "_pareto.png"
+    mp.save_figure(fig, out)
+    return [out]
+
+
+def finest_throughput(rows):
+    """{(transfer, kernel): particle-steps/s of the finest ok level}."""
+    best = {}
+    for r in rows:
+        if r["status"] != "ok":
+            continue
+        key = (r["transfer"], r["kernel"])
+        level = num(r, "level")
+        if key not in best or level > best[key][0]:
+            best[key] = (level, num(r, "particle_steps_per_second"))
+    return {k: v for k, (_, v) in best.items() if np.isfinite(v)}
+
+
+def plot_throughput(suites, tables):
+    cases = [(os.path.basename(p)[:-4], finest_throughput(read_rows(p)))
+             for p in tables]
+    cases = [(c, t) for c, t in cases if t]
+    if not cases:
+        return []
+    fig, axes = plt.subplots(1, len(cases), squeeze=False,
+                             figsize=(4.0 * len(cases) + 1.0, 4.2))
+    for ax, (case, rates) in zip(axes[0], cases):
+        methods = methods_of([{"transfer": t, "kernel": k} for t, k in rates])
+        for i, m in enumerate(methods):
+            ax.barh(i, rates[m], **mp.bar_style(*m))
+            ax.annotate(f" {rates[m]:.3g}", (rates[m], i), va="center",
+                        fontsize=7)
+        ax.set_yticks(range(len(methods)), [f"{t}-{k}" for t, k in methods],
+                      fontsize=8)
+        ax.invert_yaxis()
+        ax.margins(x=0.2)
+        ax.set_xlabel("particle-steps per second (finest level, 1 thread)")
+        ax.set_title(case, fontsize=9)
+        ax.grid(True, axis="x", alpha=0.3)
+    fig.tight_layout()
+    out = os.path.join(suites, "speed_accuracy", "throughput.png")
+    mp.save_figure(fig, out)
+    return [out]
+
+
+def speed_tables(suites):
+    return sorted(glob.glob(os.path.join(suites, "speed_accuracy", "*.csv")))
+
+
+def plot_speed_accuracy(suites):
+    out = []
+    tables = speed_tables(suites)
+    for path in tables:
+        out += plot_pareto(path)
+    out += plot_throughput(suites, tables)
+    return out
+
+
+def plot_all_suites(suites):
+    """Every suite figure under the suite folder; returns their paths."""
+    return (plot_convergence(suites) + plot_stability_map(suites)
+            + plot_failure_modes(suites) + plot_speed_accuracy(suites))

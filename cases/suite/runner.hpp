@@ -1,0 +1,69 @@
+// Runs many `mpmtb run` invocations as child processes, up to N at once.
+//
+// Each run owns a folder. A run is finished when its folder holds `done.json`,
+// the completion marker, written last and atomically after the child has
+// exited and its summary.json is final. A later call skips finished runs, so
+// a suite killed at any moment (even by SIGKILL) resumes where it stopped and
+// redoes only the unfinished runs. The marker records the run's arguments and
+// the git revision of the build; a run whose definition or revision has changed
+// since is redone (uncommitted changes do not count: remove the folder then). A child that crashes
+// or hangs is a data point (status `crashed`), never a crash of the suite.
+#pragma once
+
+#include <nlohmann/json.hpp>
+
+#include <filesystem>
+#include <optional>
+#include <string>
+#include <vector>
+
+namespace mpmtb::suite {
+
+// One `mpmtb run` of a suite.
+struct RunSpec {
+  std::string case_name, scene;
+  int dim = 1;
+  std::string transfer, kernel;
+  int cells = 16, ppc = 2;
+  std::optional<double> cfl, dt, t_end;
+  std::vector<std::string> sets;  // --set key=value
+  std::filesystem::path dir;      // the run's folder, relative to the suite root
+  // Free-form labels copied into the tables (level, study, ...).
+  nlohmann::json tags = nlohmann::json::object();
+
+  std::vector<std::string> arguments(const std::filesystem::path& out) const;
+};
+
+struct RunResult {
+  std::string status;  // ok | unstable | invalid | crashed
+  std::string reason;
+  nlohmann::json summary;  // the run's summary.json
+};
+
+struct RunnerOptions {
+  int jobs = 1;
+  bool quiet = false;
+  std::string title;             // shown in progress lines
+  double timeout_seconds = 600;  // a run longer than this is killed (`crashed`)
+  std::string executable;        // default: this program (/proc/self/exe)
+};
+
+struct RunnerStats {
+  int total = 0, finished_before = 0, ran = 0;
+};
+
+// Thrown when SIGINT or SIGTERM stops the suite; unfinished runs keep no marker.
+struct Interrupted : std::runtime_error {
+  Interrupted() : std::runtime_error("interrupted") {}
+};
+
+// Runs every spec not yet finished under `root`, then returns every result in
+// the order of `specs`.
+std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const std::filesystem::path& root,
+                               const RunnerOptions& options, RunnerStats* stats = nullptr);
+
+// The failure class of an unstable or crashed run's reason: nan, J<=0,
+// left-domain, energy-growth, crashed, invalid, or empty for ok runs.
+std::string failure_kind(const RunResult& r);
+
+}  // namespace mpmtb::suite

@@ -1,0 +1,485 @@
+#include "suite.hpp"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <fstream>
+#include <map>
+#include <sstream>
+#include <thread>
+
+#include "analysis.hpp"
+#include "cases.hpp"
+#include "core/registry.hpp"
+#include "output.hpp"
+#include "runner.hpp"
+#include "scene.hpp"
+#include "setup.hpp"
+
+namespace mpmtb {
+namespace {
+
+namespace fs = std::filesystem;
+using nlohmann::json;
+using suite::kNaN;
+using suite::RunResult;
+using suite::RunSpec;
+
+struct Method {
+  std::string transfer, kernel;
+  std::string name() const { return transfer + "-" + kernel; }
+};
+
+bool wanted(const std::vector<std::string>& filter, const std::string& name) {
+  return filter.empty() || std::find(filter.begin(), filter.end(), name) != filter.end();
+}
+
+std::vector<Method> methods(const SuiteRequest& r) {
+  std::vector<Method> m;
+  for (const auto& t : transfer_list()) {
+    for (const auto& k : kernel_list()) {
+      if (wanted(r.transfers, t.name) && wanted(r.kernels, k.name) &&
+          unsupported_reason(t.name, k.name).empty()) {
+        m.push_back({t.name, k.name});
+      }
+    }
+  }
+  return m;
+}
+
+bool scene_exists(const std::string& name) {
+  for (const auto& b : builtin_scenes()) {
+    if (b.name == name) return true;
+  }
+  return false;
+}
+
+// A case runs if it passes the filter and its scene is built in.
+bool runnable(const SuiteRequest& r, const std::string& name, const std::string& scene) {
+  if (!wanted(r.cases, name)) return false;
+  if (scene_exists(scene)) return true;
+  if (!r.quiet)
+    fmt::print(stderr, "suite: case '{}' skipped: no built-in scene '{}'\n", name, scene);
+  return false;
+}
+
+// ------------------------------------------------------------- tables --
+
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) {
+    q += c;
+    if (c == '"') q += c;
+  }
+  return q + '"';
+}
+
+// A number for a table; NaN (missing, unstable) is an empty cell.
+std::string num(double v) {
+  return std::isfinite(v) ? fmt::format("{:.6g}", v) : "";
+}
+
+struct Table {
+  std::vector<std::string> header;
+  std::vector<std::vector<std::string>> rows;
+  void write(const fs::path& path) const {
+    std::string s;
+    auto line = [&](const std::vector<std::string>& cells) {
+      for (std::size_t i = 0; i < cells.size(); ++i) {
+        if (i) s += ',';
+        s += csv_field(cells[i]);
+      }
+      s += '\n';
+    };
+    line(header);
+    for (const auto& r : rows) line(r);
+    write_atomically(path, s);
+  }
+};
+
+double number_of(const json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? j[key].get<double>() : kNaN;
+}
+
+double error_of(const RunResult& r, const std::string& key) {
+  if (r.status != "ok" || !r.summary.contains("error")) return kNaN;
+  return number_of(r.summary["error"], key.c_str());
+}
+
+std::string int_text(const json& j, const char* key) {
+  return j.contains(key) && j[key].is_number() ? std::to_string(j[key].get<long>()) : "";
+}
+
+Overrides overrides_for(const std::string& /*scene*/, int dim, int cells,
+                        const std::vector<std::string>& sets) {
+  Overrides o;
+  o.dim = dim;
+  o.cells = cells;
+  o.set = sets;
+  return o;
+}
+
+// Largest wave speed c_p of a scene's materials (for the fixed-dt study).
+double wave_speed(const Scene& s) {
+  switch (s.dim) {
+    case 1:
+      return build_state<1>(s).max_wave_speed();
+    case 2:
+      return build_state<2>(s).max_wave_speed();
+    default:
+      return build_state<3>(s).max_wave_speed();
+  }
+}
+
+suite::RunnerOptions runner_options(const SuiteRequest& r, const std::string& title) {
+  suite::RunnerOptions o;
+  o.jobs = r.jobs > 0 ? r.jobs : std::max(1u, std::thread::hardware_concurrency());
+  o.quiet = r.quiet;
+  o.title = title;
+  return o;
+}
+
+void note(const SuiteRequest& r, const std::string& text) {
+  if (!r.quiet) fmt::print(stderr, "{}\n", text);
+}
+
+// --------------------------------------------------------- convergence --
+
+// One refinement series: a method on a case, grid or time-step study.
+struct Series {
+  std::string case_name, study, error_key;
+  Method method;
+  std::vector<std::size_t> runs;  // indices into the spec list, coarse to fine
+  std::vector<double> h, dt;
+};
+
+RunSpec make_spec(const std::string& case_name, const std::string& scene, int dim, const Method& m,
+                  int cells, double t_end, const std::vector<std::string>& sets) {
+  RunSpec s;
+  s.case_name = case_name;
+  s.scene = scene;
+  s.dim = dim;
+  s.transfer = m.transfer;
+  s.kernel = m.kernel;
+  s.cells = cells;
+  s.sets = sets;
+  if (t_end > 0) s.t_end = t_end;
+  return s;
+}
+
+// The grid study (and the time-step study when asked) of every method on a case.
+void plan_refinement(const SuiteRequest& r, const suite::ConvergenceCase& c, bool dt_study,
+                     std::vector<RunSpec>& specs, std::vector<Series>& series) {
+  const suite::Levels levels = r.full ? c.full : c.quick;
+  const double t_end = r.full ? c.t_end_full : c.t_end_quick;
+  const int dt_cells = dt_study ? (r.full ? c.dt_cells_full : c.dt_cells_quick) : 0;
+  const Scene base = load_scene(c.scene, overrides_for(c.scene, c.dim, 8, c.sets));
+  double dt0 = kNaN;
+  if (dt_cells > 0) {
+    const Scene s = load_scene(c.scene, overrides_for(c.scene, c.dim, dt_cells, c.sets));
+    dt0 = c.dt_cfl * s.dx() / wave_speed(s);
+  }
+  for (const Method& m : methods(r)) {
+    Series g{c.name, "grid", c.error_key, m, {}, {}, {}};
+    const auto cells = levels.cells();
+    for (std::size_t k = 0; k < cells.size(); ++k) {
+      RunSpec s = make_spec(c.name, c.scene, c.dim, m, cells[k], t_end, c.sets);
+      s.cfl = c.cfl;
+      s.dir = fs::path("runs") / c.name / m.name() / fmt::format("L{}", k);
+      g.runs.push_back(specs.size());
+      g.h.push_back(base.length / cells[k]);
+      specs.push_back(std::move(s));
+    }
+    if (!g.runs.empty()) series.push_back(std::move(g));
+    if (dt_cells <= 0) continue;
+    Series d{c.name, "dt", c.error_key, m, {}, {}, {}};
+    for (int k = 0; k < 5; ++k) {
+      RunSpec s = make_spec(c.name, c.scene, c.dim, m, dt_cells, t_end, c.sets);
+      s.dt = dt0 / (1 << k);
+      s.dir = fs::path("runs") / c.name / m.name() / fmt::format("dt{}", k);
+      d.runs.push_back(specs.size());
+      d.h.push_back(base.length / dt_cells);
+      d.dt.push_back(*s.dt);
+      specs.push_back(std::move(s));
+    }
+    series.push_back(std::move(d));
+  }
+}
+
+void write_convergence_tables(const fs::path& root, const std::vector<Series>& series,
+                              const std::vector<RunResult>& results) {
+  std::map<std::string, Table> tables;  // file name -> table
+  Table orders{{"case", "study", "transfer", "kernel", "fitted_order", "fit_from_level",
+                "fit_to_level", "fit_h_max", "fit_h_min", "finest_error", "levels_ok", "levels"},
+               {}};
+  for (const Series& g : series) {
+    const bool dt = g.study == "dt";
+    const std::string file = g.case_name + (dt ? "_dt.csv" : ".csv");
+    Table& t = tables[file];
+    if (t.header.empty()) {
+      t.header = {"case", "study",  "transfer", "kernel", "level", "cells",  "ppc",   "h",
+                  "dt",   "status", "failure",  "error",  "order", "in_fit", "reason"};
+    }
+    std::vector<double> e, step;
+    for (std::size_t k = 0; k < g.runs.size(); ++k) {
+      const RunResult& r = results[g.runs[k]];
+      e.push_back(error_of(r, g.error_key));
+      step.push_back(dt ? g.dt[k] : number_of(r.summary, "dt_max"));
+    }
+    // The time-step study refines dt at a fixed grid: the order is in dt.
+    const std::vector<double>& size = dt ? g.dt : g.h;
+    const auto p = suite::observed_orders(size, e);
+    const auto fit = suite::fit_order(size, e);
+    int ok = 0;
+    for (std::size_t k = 0; k < g.runs.size(); ++k) {
+      const RunResult& r = results[g.runs[k]];
+      ok += r.status == "ok";
+      const bool in_fit = static_cast<int>(k) >= fit.first && static_cast<int>(k) <= fit.last;
+      t.rows.push_back({g.case_name, g.study, g.method.transfer, g.method.kernel, std::to_string(k),
+                        int_text(r.summary, "cells"), int_text(r.summary, "ppc"), num(g.h[k]),
+                        num(step[k]), r.status, suite::failure_kind(r), num(e[k]), num(p[k]),
+                        in_fit ? "1" : "0", r.status == "ok" ? "" : r.reason});
+    }
+    const bool has_fit = fit.first >= 0;
+    orders.rows.push_back({g.case_name, g.study, g.method.transfer, g.method.kernel, num(fit.order),
+                           has_fit ? std::to_string(fit.first) : "",
+                           has_fit ? std::to_string(fit.last) : "",
+                           has_fit ? num(size[fit.first]) : "", has_fit ? num(size[fit.last]) : "",
+                           num(e.back()), std::to_string(ok), std::to_string(g.runs.size())});
+  }
+  for (const auto& [file, t] : tables) t.write(root / file);
+  orders.write(root / "orders.csv");
+}
+
+int run_convergence(const SuiteRequest& r) {
+  const fs::path root = fs::path(r.out) / "convergence";
+  std::vector<RunSpec> specs;
+  std::vector<Series> series;
+  for (const auto& c : suite::convergence_cases()) {
+    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, true, specs, series);
+  }
+  const auto results = suite::run_all(specs, root, runner_options(r, "suite convergence"));
+  write_convergence_tables(root, series, results);
+  note(r, fmt::format("suite convergence: tables in {}", root.string()));
+  return 0;
+}
+
+// ------------------------------------------------------------ stability --
+
+std::vector<double> cfl_grid(const suite::StabilityCase& c, bool full) {
+  const double step = full ? c.full_step : c.quick_step;
+  const int n = static_cast<int>(std::floor((c.cfl_last - c.cfl_first) / step + 1e-9)) + 1;
+  std::vector<double> v;
+  for (int i = 0; i < n; ++i) v.push_back(std::round((c.cfl_first + i * step) * 1e6) / 1e6);
+  return v;
+}
+
+std::map<std::string, std::vector<double>> read_series(const fs::path& path) {
+  std::map<std::string, std::vector<double>> cols;
+  std::ifstream in(path);
+  std::string line;
+  std::vector<std::string> names;
+  if (!std::getline(in, line)) return cols;
+  std::stringstream hs(line);
+  for (std::string n; std::getline(hs, n, ',');) names.push_back(n);
+  while (std::getline(in, line)) {
+    std::stringstream ls(line);
+    std::size_t i = 0;
+    for (std::string v; std::getline(ls, v, ',') && i < names.size(); ++i) {
+      cols[names[i]].push_back(std::strtod(v.c_str(), nullptr));
+    }
+  }
+  return cols;
+}
+
+double failure_metric(const std::string& metric, const fs::path& dir, const RunResult& r) {
+  if (r.status != "ok") return kNaN;
+  auto s = read_series(dir / "series.csv");
+  const auto& t = s["total"];
+  if (t.empty() || s["strain"].size() != t.size() || s["kinetic"].size() != t.size()) return kNaN;
+  if (metric == "strain_max_rel") {
+    const double e0 = s["kinetic"][0] + s["strain"][0];
+    return *std::max_element(s["strain"].begin(), s["strain"].end()) / e0;
+  }
+  if (metric == "energy_kept") return t.back() / t.front();
+  if (metric == "L_change") {
+    double d2 = 0, l2 = 0;
+    for (const char* c : {"Lx", "Ly", "Lz"}) {
+      const auto& L = s[c];
+      if (L.empty()) return kNaN;
+      d2 += (L.back() - L.front()) * (L.back() - L.front());
+      l2 += L.front() * L.front();
+    }
+    return l2 > 0 ? std::sqrt(d2 / l2) : kNaN;
+  }
+  return kNaN;
+}
+
+struct Sweep {  // one method and ppc on a stability case: runs in CFL order
+  std::string case_name;
+  int dim;
+  Method method;
+  int ppc;
+  std::vector<double> cfl;
+  std::vector<std::size_t> runs;
+};
+
+void write_stability_tables(const fs::path& root, const std::vector<Sweep>& sweeps,
+                            const std::vector<RunResult>& results) {
+  std::map<std::string, Table> per_case;
+  Table stable{{"case", "dim", "transfer", "kernel", "ppc", "stable_cfl", "first_unstable_cfl",
+                "failure", "fail_step", "vn_low", "vn_high", "reason"},
+               {}};
+  for (const Sweep& s : sweeps) {
+    Table& t = per_case[s.case_name];
+    if (t.header.empty()) {
+      t.header = {"case",   "transfer", "kernel",    "ppc",   "cfl",
+                  "status", "failure",  "fail_step", "steps", "reason"};
+    }
+    std::vector<bool> ok;
+    for (std::size_t i = 0; i < s.runs.size(); ++i) {
+      const RunResult& r = results[s.runs[i]];
+      ok.push_back(r.status == "ok");
+      t.rows.push_back({s.case_name, s.method.transfer, s.method.kernel, std::to_string(s.ppc),
+                        num(s.cfl[i]), r.status, suite::failure_kind(r),
+                        int_text(r.summary, "fail_step"), int_text(r.summary, "steps"),
+                        r.status == "ok" ? "" : r.reason});
+    }
+    const auto range = suite::largest_stable(s.cfl, ok);
+    const auto vn = suite::von_neumann_cfl(s.method.kernel, s.dim);
+    std::string kind, step, reason;
+    if (range.first_unstable_index >= 0) {
+      const RunResult& r = results[s.runs[range.first_unstable_index]];
+      kind = suite::failure_kind(r);
+      step = int_text(r.summary, "fail_step");
+      reason = r.reason;
+    }
+    stable.rows.push_back({s.case_name, std::to_string(s.dim), s.method.transfer, s.method.kernel,
+                           std::to_string(s.ppc), num(range.stable), num(range.first_unstable),
+                           kind, step, num(vn.low), num(vn.high), reason});
+  }
+  for (const auto& [name, t] : per_case) t.write(root / (name + ".csv"));
+  stable.write(root / "stable_cfl.csv");
+}
+
+int run_stability(const SuiteRequest& r) {
+  const fs::path root = fs::path(r.out) / "stability";
+  std::vector<RunSpec> specs;
+  std::vector<Sweep> sweeps;
+  for (const auto& c : suite::stability_cases()) {
+    if (!runnable(r, c.name, c.scene)) continue;
+    const auto grid = cfl_grid(c, r.full);
+    for (const Method& m : methods(r)) {
+      for (int ppc : r.full ? c.full_ppc : c.quick_ppc) {
+        Sweep s{c.name, c.dim, m, ppc, grid, {}};
+        for (double cfl : grid) {
+          RunSpec spec = make_spec(c.name, c.scene, c.dim, m, c.cells, c.t_end, c.sets);
+          spec.ppc = ppc;
+          spec.cfl = cfl;
+          spec.dir =
+              fs::path("runs") / c.name / m.name() / fmt::format("ppc{}-cfl{:.3f}", ppc, cfl);
+          s.runs.push_back(specs.size());
+          specs.push_back(std::move(spec));
+        }
+        sweeps.push_back(std::move(s));
+      }
+    }
+  }
+  // Failure modes shown on purpose, every method on each case.
+  struct Mode {
+    std::string case_name, metric;
+    Method method;
+    std::size_t run;
+  };
+  std::vector<Mode> modes;
+  for (const auto& c : suite::failure_mode_cases()) {
+    if (!runnable(r, c.name, c.scene)) continue;
+    const Scene base = load_scene(c.scene, {});
+    for (const Method& m : methods(r)) {
+      RunSpec spec =
+          make_spec(c.name, c.scene, c.dim, m, c.cells > 0 ? c.cells : base.cells, c.t_end, c.sets);
+      spec.ppc = base.ppc;
+      spec.dir = fs::path("runs") / "failure_modes" / c.name / m.name();
+      modes.push_back({c.name, c.metric, m, specs.size()});
+      specs.push_back(std::move(spec));
+    }
+  }
+  const auto results = suite::run_all(specs, root, runner_options(r, "suite stability"));
+  write_stability_tables(root, sweeps, results);
+  Table t{{"case", "metric", "transfer", "kernel", "status", "value", "reason"}, {}};
+  for (const Mode& m : modes) {
+    const RunResult& res = results[m.run];
+    t.rows.push_back({m.case_name, m.metric, m.method.transfer, m.method.kernel, res.status,
+                      num(failure_metric(m.metric, root / specs[m.run].dir, res)),
+                      res.status == "ok" ? "" : res.reason});
+  }
+  if (!modes.empty()) t.write(root / "failure_modes.csv");
+  note(r, fmt::format("suite stability: tables in {}", root.string()));
+  return 0;
+}
+
+// ------------------------------------------------------- speed-accuracy --
+
+int run_speed_accuracy(const SuiteRequest& r) {
+  const fs::path root = fs::path(r.out) / "speed_accuracy";
+  std::vector<RunSpec> specs;
+  std::vector<Series> series;
+  for (const auto& c : suite::speed_accuracy_cases()) {
+    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, false, specs, series);
+  }
+  const auto results = suite::run_all(specs, root, runner_options(r, "suite speed-accuracy"));
+  std::map<std::string, std::vector<const Series*>> by_case;
+  for (const auto& g : series) by_case[g.case_name].push_back(&g);
+  for (const auto& [name, groups] : by_case) {
+    std::vector<double> wall, work, err;
+    std::vector<std::pair<const Series*, std::size_t>> rows;
+    for (const Series* g : groups) {
+      for (std::size_t k = 0; k < g->runs.size(); ++k) {
+        const RunResult& res = results[g->runs[k]];
+        const double e = error_of(res, g->error_key);
+        const double ok = res.status == "ok" ? 1.0 : kNaN;
+        wall.push_back(ok * number_of(res.summary, "wall_seconds"));
+        work.push_back(ok * number_of(res.summary, "particles") * number_of(res.summary, "steps"));
+        err.push_back(e);
+        rows.emplace_back(g, k);
+      }
+    }
+    const auto front_time = suite::pareto_front(wall, err);
+    const auto front_work = suite::pareto_front(work, err);
+    Table t{{"case", "transfer", "kernel", "level", "cells", "h", "particles", "steps",
+             "particle_steps", "wall_seconds", "step_seconds", "particle_steps_per_second",
+             "status", "error", "pareto_time", "pareto_work"},
+            {}};
+    for (std::size_t i = 0; i < rows.size(); ++i) {
+      const auto& [g, k] = rows[i];
+      const RunResult& res = results[g->runs[k]];
+      const json& s = res.summary;
+      t.rows.push_back(
+          {name, g->method.transfer, g->method.kernel, std::to_string(k), int_text(s, "cells"),
+           num(g->h[k]), int_text(s, "particles"), int_text(s, "steps"), num(work[i]), num(wall[i]),
+           num(number_of(s, "step_seconds")), num(number_of(s, "particle_steps_per_second")),
+           res.status, num(err[i]), front_time[i] ? "1" : "0", front_work[i] ? "1" : "0"});
+    }
+    t.write(root / (name + ".csv"));
+  }
+  note(r, fmt::format("suite speed-accuracy: tables in {}", root.string()));
+  return 0;
+}
+
+}  // namespace
+
+int command_suite(const SuiteRequest& request) {
+  try {
+    const std::string& n = request.name;
+    if (n == "convergence" || n == "all") run_convergence(request);
+    if (n == "stability" || n == "all") run_stability(request);
+    if (n == "speed-accuracy" || n == "all") run_speed_accuracy(request);
+  } catch (const suite::Interrupted&) {
+    fmt::print(stderr, "suite: interrupted; finished runs are kept, run again to resume\n");
+    return 130;
+  }
+  return 0;
+}
+
+}  // namespace mpmtb
