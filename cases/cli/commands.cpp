@@ -10,6 +10,8 @@
 #include "core/registry.hpp"
 #include "models/registry.hpp"
 #include "output.hpp"
+#include "progress.hpp"
+#include "reproduce.hpp"
 
 namespace mpmtb {
 namespace {
@@ -114,18 +116,25 @@ int command_list(const std::string& only) {
   return kExitOk;
 }
 
-int command_describe(const std::string& scene, const Overrides& overrides) {
-  const Scene s = load_scene(scene, overrides);
-  std::cout << "# " << s.source << " (after overrides)\n" << s.resolved << "\n";
-  return kExitOk;
-}
-
 int command_run(const RunRequest& request) {
   const auto transfers = expand(request.overrides.transfer, transfer_list());
   const auto kernels = expand(request.overrides.kernel, kernel_list());
   const bool sweep = transfers.size() > 1 || kernels.size() > 1;
   std::vector<std::pair<std::string, RunOutcome>> runs;
   int worst = kExitOk;
+  // --config: the recorded scene (and thread count, for identical output).
+  nlohmann::json recorded;
+  RunOptions options = request.options;
+  if (!request.config.empty()) {
+    recorded = read_summary(request.config);
+    if (options.threads == 0) options.threads = recorded_threads(recorded).value_or(0);
+  }
+  auto load = [&](const Overrides& o) {
+    return request.config.empty() ? load_scene(request.scene, o)
+                                  : load_recorded_scene(recorded, request.config, o);
+  };
+  options.progress = Progress::wanted(request.quiet);
+  const std::string label = request.config.empty() ? request.scene : request.config;
   for (const auto& t : transfers) {
     for (const auto& k : kernels) {
       Overrides o = request.overrides;
@@ -136,23 +145,26 @@ int command_run(const RunRequest& request) {
           sweep ? std::filesystem::path(request.out) / name : std::filesystem::path(request.out);
       RunOutcome r;
       try {
-        const Scene scene = load_scene(request.scene, o);
+        const Scene scene = load(o);
         if (sweep) {
           if (auto why = unsupported_reason(scene.transfer, scene.kernel); !why.empty()) {
             // A refused combination is a data point of a sweep, not a failure.
             r = write_invalid(dir, why, {{"transfer", t}, {"kernel", k}, {"dim", scene.dim}});
             runs.emplace_back(name, r);
-            fmt::print(stderr, "{:<24} refused: {}\n", name, why);
+            if (!request.quiet) fmt::print(stderr, "{:<24} refused: {}\n", name, why);
             continue;
           }
         }
-        r = run_scene(scene, dir, request.options);
+        options.label = sweep ? name : label;
+        r = run_scene(scene, dir, options);
       } catch (const InputError& e) {
         if (!sweep) throw;
         r = write_invalid(dir, e.what(), {{"transfer", t}, {"kernel", k}});
       }
-      fmt::print(stderr, "{:<24} {}{}{}\n", sweep ? name : request.scene, r.status,
-                 r.reason.empty() ? "" : ": ", r.reason);
+      if (!request.quiet) {
+        fmt::print(stderr, "{:<24} {}{}{}\n", sweep ? name : label, r.status,
+                   r.reason.empty() ? "" : ": ", r.reason);
+      }
       worst = std::max(worst, exit_status(r.status));
       runs.emplace_back(name, std::move(r));
     }
