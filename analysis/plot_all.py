@@ -317,7 +317,11 @@ def main(argv=None):
     for sweep in sweeps:
         plot_sweep(sweep)
         print(f"{sweep.title}: {', '.join(sweep.figures) or 'no figures'}")
-    mp.save_text(os.path.join(args.results, "README.md"), readme(sweeps))
+    text = readme(sweeps)
+    if os.path.exists(os.path.join(args.results, "gallery", "README.md")):
+        text += ("\n## Gallery\n\nPictures drawn from ParaView frames by analysis/render.py "
+                 "(`bash scripts/gallery.sh`): [gallery/README.md](gallery/README.md)\n")
+    mp.save_text(os.path.join(args.results, "README.md"), text)
     print(f"wrote {os.path.join(args.results, 'README.md')}")
     return 0
 

@@ -120,6 +120,9 @@ class Run:
         self.lo = np.array(dom.get("min", [0, 0, 0]), float)
         self.hi = np.array(dom.get("max", [1, 1, 1]), float)
         self.colliders = config.get("colliders", [])
+        # Up: against gravity when there is some, else z.
+        g = np.array(config.get("physics", {}).get("gravity", [0, 0, 0]), float)
+        self.up = int(np.argmax(np.abs(g))) if np.any(g) else 2
         self.cache = {}
 
     def load(self, k):
@@ -135,7 +138,9 @@ def color_range(run, field, picks, vmin, vmax):
     else:
         values = np.concatenate([field_values(run.load(k)[1], field) for k in picks])
         values = values[np.isfinite(values)]
-        lo, hi = (float(values.min()), float(values.max())) if values.size else (0.0, 1.0)
+        # 0.1 and 99.9 percentiles: a few extreme particles do not wash out the rest.
+        lo, hi = (float(np.percentile(values, 0.1)), float(np.percentile(values, 99.9))) \
+            if values.size else (0.0, 1.0)
         if lo < 0 < hi:
             lo, hi = -max(-lo, hi), max(-lo, hi)
         elif lo >= 0 and field != "J":
@@ -159,15 +164,18 @@ def view_axes(run, view, points):
     return {"x": (1, 2, 0), "y": (0, 2, 1), "z": (0, 1, 2)}.get(view, "iso"), view
 
 
-def project(points, view, axes):
+def project(points, axes, up):
     """Screen coordinates (n, 2) and depth (larger = nearer the camera)."""
     if axes == "iso":
-        az, el = np.radians(-35.0), np.radians(25.0)
-        right = np.array([np.cos(az), np.sin(az), 0.0])
-        toward = np.array([-np.sin(az) * np.cos(el), np.cos(az) * np.cos(el), np.sin(el)])
-        toward = -toward  # camera in front, above
-        up = np.cross(toward, right)
-        return np.stack([points @ right, points @ up], axis=1), points @ toward
+        # Camera 30 degrees around the up axis from the next axis, 25 degrees above.
+        u = np.eye(3)[up]
+        a, b = np.eye(3)[(up + 1) % 3], np.eye(3)[(up + 2) % 3]  # (a, b, up) right-handed
+        az, el = np.radians(30.0), np.radians(25.0)
+        toward = np.cos(el) * (np.cos(az) * a + np.sin(az) * b) + np.sin(el) * u
+        right = np.cross(u, toward)
+        right /= np.linalg.norm(right)
+        screen_up = np.cross(toward, right)
+        return np.stack([points @ right, points @ screen_up], axis=1), points @ toward
     a, b, d = axes
     return points[:, [a, b]], points[:, d]
 
@@ -202,7 +210,7 @@ def draw_frame(fig, ax, cax, run, k, field, norm, cmap, args):
                     others = [i for i in range(3) if i != axis]
                     axes = (others[0], others[1], axis)
             points, values = points[keep], values[keep]
-            xy, depth = project(points, view, axes)
+            xy, depth = project(points, axes, run.up)
             sx, sy = (axes[0], axes[1]) if axes != "iso" else (None, None)
         rgba = cmap(norm(values))
         if depth is not None and len(depth):
@@ -231,8 +239,12 @@ def draw_frame(fig, ax, cax, run, k, field, norm, cmap, args):
         if sx is not None:
             for c in run.colliders:  # the kinematic ball, where it is at this time
                 center = np.array(c["center"], float) + time * np.array(c.get("velocity", [0, 0, 0]), float)
-                ax.add_patch(plt.Circle((center[sx], center[sy]), float(c["radius"]), fill=False,
-                                        ls="--", lw=1.2, color="0.2"))
+                r2 = float(c["radius"]) ** 2
+                if run.dim == 3 and args.cut:  # its section by the cut plane
+                    r2 -= (center[args.cut[0]] - args.cut[1]) ** 2
+                if r2 > 0:
+                    ax.add_patch(plt.Circle((center[sx], center[sy]), np.sqrt(r2), fill=False,
+                                            ls="--", lw=1.2, color="0.2", zorder=3))
     cut = f", cut {'xyz'[args.cut[0]]} = {args.cut[1]:g}" if args.cut else ""
     ax.set_title(f"{run.scene} ({run.dim}D): {label}, t = {time:.4g}{cut}")
     cax.clear()

@@ -85,9 +85,9 @@ int exit_status(const std::string& status) {
 }  // namespace
 
 int command_list(const std::string& only) {
-  auto section = [&](const char* title, const auto& items) {
+  auto section = [&](const char* title, const char* how, const auto& items) {
     if (!only.empty() && only != title) return;
-    if (only.empty()) fmt::print("{}:\n", title);
+    if (only.empty()) fmt::print("{} ({}):\n", title, how);
     for (const auto& i : items) {
       if (only.empty()) {
         fmt::print("  {:<16} {}\n", i.name, i.description);
@@ -96,22 +96,30 @@ int command_list(const std::string& only) {
       }
     }
   };
-  section("transfers", transfer_list());
-  section("kernels", kernel_list());
-  section("models", model_list());
+  section("transfers", "--transfer, [method] transfer", transfer_list());
+  section("kernels", "--kernel, [method] kernel", kernel_list());
+  section("models", "--model, [materials.NAME] model", model_list());
   std::vector<VariantInfo> scenes;
   for (const auto& b : builtin_scenes()) {
     const Scene s = load_scene(b.name);
     scenes.push_back({b.name, fmt::format("{} (dims {})", s.description, fmt::join(s.dims, ","))});
   }
-  section("scenes", scenes);
+  section("scenes", "mpmtb run NAME; mpmtb describe NAME for its parameters", scenes);
   if (only.empty()) {
-    fmt::print("refused combinations:\n");
+    const std::vector<VariantInfo> walls = {
+        {"free", "open: nothing imposed"},
+        {"sticky", "v = 0 on the face (no-slip)"},
+        {"slip", "normal velocity removed, tangential kept"},
+        {"separate", "normal velocity removed only while pressing into the wall"}};
+    section("walls", "[boundary] x_min ... z_max, default; [[colliders]] wall", walls);
+    std::vector<std::string> refused;
     for (const auto& t : transfer_list()) {
       for (const auto& k : kernel_list()) {
-        if (auto r = unsupported_reason(t.name, k.name); !r.empty()) fmt::print("  {}\n", r);
+        if (auto r = unsupported_reason(t.name, k.name); !r.empty()) refused.push_back(r);
       }
     }
+    fmt::print("refused combinations:{}\n", refused.empty() ? " none" : "");
+    for (const auto& r : refused) fmt::print("  {}\n", r);
   }
   return kExitOk;
 }
