@@ -299,8 +299,8 @@ def parse_args(argv):
 def figure(size):
     w, h = (int(v) for v in size.lower().split("x"))
     fig = plt.figure(figsize=(w / DPI, h / DPI), dpi=DPI)
-    ax = fig.add_axes([0.09, 0.09, 0.74, 0.82])
-    cax = fig.add_axes([0.87, 0.09, 0.03, 0.82])
+    ax = fig.add_axes([0.12, 0.1, 0.68, 0.8])
+    cax = fig.add_axes([0.83, 0.1, 0.03, 0.8])
     return fig, ax, cax
 
 

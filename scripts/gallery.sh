@@ -11,7 +11,7 @@ out=results/gallery
 render() { /usr/bin/python3 analysis/render.py "$@" >/dev/null; }
 mkdir -p "$out"
 "$mpmtb" run bar --frames-dt 0.2 --quiet --out "$runs/bar"
-"$mpmtb" run disks --frames-dt 0.05 --quiet --out "$runs/disks"
+"$mpmtb" run disks --cells 40 --frames-dt 0.05 --quiet --out "$runs/disks"
 "$mpmtb" run pinned_block --frames-dt 0.005 --quiet --out "$runs/pinned_block" || [ $? -eq 3 ]
 render "$runs/bar" --size 900x600 --out "$out/bar_velocity.png"
 render "$runs/disks" --frame 35 --size 800x700 --out "$out/disks_stress.png"  # t = 1.75, in contact
@@ -19,6 +19,6 @@ render "$runs/pinned_block" --size 800x700 --out "$out/pinned_block_damage.png"
 render "$runs/pinned_block" --view iso --size 800x700 --out "$out/pinned_block_damage_iso.png"
 render "$runs/pinned_block" --cut z=0.25 --field von_mises --frame 20 --size 800x700 \
   --out "$out/pinned_block_stress_cut.png"  # t = 0.1, the ball inside the block
-render "$runs/pinned_block" --size 400x350 --out "$runs/last.png" --anim-size 400x350 --fps 8 \
+render "$runs/pinned_block" --size 480x420 --out "$runs/last.png" --anim-size 480x420 --fps 8 \
   --gif "$out/pinned_block_damage.gif"
 echo "mpmtb: gallery in $out ($(du -sh "$out" | cut -f1))"
