@@ -138,9 +138,10 @@ int main(int argc, char** argv) {
   auto* render = app.add_subcommand(
       "render",
       "draw a run's frames to PNG/GIF (forwards to /usr/bin/python3 analysis/render.py; "
-      "`mpmtb render -- --help` lists its options)");
+      "`mpmtb render --help` lists its options)");
   render->allow_extras();
   render->prefix_command();
+  render->set_help_flag();  // --help goes to render.py
 
   try {
     app.parse(argc, argv);
