@@ -330,8 +330,11 @@ def main(argv=None):
         print(f"plot_all.py: error: malformed suite table: {exc}",
               file=sys.stderr)
         return 1
-    mp.save_text(os.path.join(args.results, "README.md"),
-                 readme(sweeps, summary))
+    text = readme(sweeps, summary)
+    if os.path.exists(os.path.join(args.results, "gallery", "README.md")):
+        text += ("\n## Gallery\n\nPictures drawn from ParaView frames by analysis/render.py "
+                 "(`bash scripts/gallery.sh`): [gallery/README.md](gallery/README.md)\n")
+    mp.save_text(os.path.join(args.results, "README.md"), text)
     print(f"wrote {os.path.join(args.results, 'README.md')}")
     return 0
 

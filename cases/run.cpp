@@ -12,8 +12,10 @@
 #include "core/registry.hpp"
 #include "extra_columns.hpp"
 #include "output.hpp"
+#include "progress.hpp"
 #include "references/reference.hpp"
 #include "setup.hpp"
+#include "vtk/frames.hpp"
 
 #ifndef MPMTB_GIT_REV
 #define MPMTB_GIT_REV "unknown"
@@ -131,7 +133,8 @@ nlohmann::json base_summary(const Scene& scene) {
 }
 
 template <int Dim>
-RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
+RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
+                   const RunOptions& options) {
   State<Dim> s = build_state<Dim>(scene);
   Parameters transfer_params = scene.transfer_params;
   auto stepper = make_stepper<Dim>(scene.transfer, scene.kernel, transfer_params);
@@ -172,6 +175,9 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
   std::string status = "ok", reason;
   double step_seconds = 0;
   const auto wall_start = std::chrono::steady_clock::now();
+  FrameSeries<Dim> frames(out_dir, options.frames);
+  frames.write(s);
+  Progress progress(options.label.empty() ? scene.name : options.label, options.progress);
 
   while (s.time < scene.t_end * (1 - 1e-12)) {
     Real dt = scene.dt ? *scene.dt : *scene.cfl * dx / (c + v_max);
@@ -182,6 +188,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
     const StepReport report = stepper->step(s, dt);
     step_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     v_max = report.v_max;
+    progress.update(s.time / scene.t_end, s.step);
     reason = failure_reason(report);
     if (!reason.empty()) {
       status = "unstable";
@@ -190,6 +197,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
     J_elastic_min = std::min(J_elastic_min, report.J_min);
     J_elastic_max = std::max(J_elastic_max, report.J_max);
     const bool last = s.time >= scene.t_end * (1 - 1e-12);
+    frames.after_step(s, last, dt);
     if (s.time >= next_output - 1e-9 * dt || last) {
       while (next_output <= s.time + 1e-9 * dt) next_output += scene.output_interval;
       const Diagnostics d = measure(s, *stepper);
@@ -216,6 +224,8 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
       if (status != "ok") break;
     }
   }
+  progress.finish();
+  frames.write(s);  // the last state, also of an unstable run (no-op if written)
   const double wall_seconds =
       std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
 
@@ -242,6 +252,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir) {
   j["J_max"] = J_max;
   j["J_elastic_min"] = J_elastic_min;
   j["J_elastic_max"] = J_elastic_max;
+  if (frames.enabled()) j["frames"] = frames.summary();
   if (reference) {
     j["error"] = reference->errors();
     j["measured"] = reference->measured();
@@ -277,11 +288,11 @@ RunOutcome run_scene(const Scene& scene, const std::filesystem::path& out_dir,
   if (options.threads > 0) omp_set_num_threads(options.threads);
   switch (scene.dim) {
     case 1:
-      return run_dim<1>(scene, out_dir);
+      return run_dim<1>(scene, out_dir, options);
     case 2:
-      return run_dim<2>(scene, out_dir);
+      return run_dim<2>(scene, out_dir, options);
     default:
-      return run_dim<3>(scene, out_dir);
+      return run_dim<3>(scene, out_dir, options);
   }
 }
 

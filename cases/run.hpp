@@ -8,11 +8,15 @@
 #include <string>
 
 #include "scene.hpp"
+#include "vtk/frame_options.hpp"
 
 namespace mpmtb {
 
 struct RunOptions {
-  int threads = 0;  // 0: OpenMP's default
+  int threads = 0;        // 0: OpenMP's default
+  FrameOptions frames;    // ParaView frames (off by default)
+  bool progress = false;  // draw a progress line on stderr (see Progress::wanted)
+  std::string label;      // names the run on the progress line
 };
 
 struct RunOutcome {

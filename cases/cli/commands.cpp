@@ -10,6 +10,8 @@
 #include "core/registry.hpp"
 #include "models/registry.hpp"
 #include "output.hpp"
+#include "progress.hpp"
+#include "reproduce.hpp"
 
 namespace mpmtb {
 namespace {
@@ -83,9 +85,9 @@ int exit_status(const std::string& status) {
 }  // namespace
 
 int command_list(const std::string& only) {
-  auto section = [&](const char* title, const auto& items) {
+  auto section = [&](const char* title, const char* how, const auto& items) {
     if (!only.empty() && only != title) return;
-    if (only.empty()) fmt::print("{}:\n", title);
+    if (only.empty()) fmt::print("{} ({}):\n", title, how);
     for (const auto& i : items) {
       if (only.empty()) {
         fmt::print("  {:<16} {}\n", i.name, i.description);
@@ -94,29 +96,31 @@ int command_list(const std::string& only) {
       }
     }
   };
-  section("transfers", transfer_list());
-  section("kernels", kernel_list());
-  section("models", model_list());
+  section("transfers", "--transfer, [method] transfer", transfer_list());
+  section("kernels", "--kernel, [method] kernel", kernel_list());
+  section("models", "--model, [materials.NAME] model", model_list());
   std::vector<VariantInfo> scenes;
   for (const auto& b : builtin_scenes()) {
     const Scene s = load_scene(b.name);
     scenes.push_back({b.name, fmt::format("{} (dims {})", s.description, fmt::join(s.dims, ","))});
   }
-  section("scenes", scenes);
+  section("scenes", "mpmtb run NAME; mpmtb describe NAME for its parameters", scenes);
   if (only.empty()) {
-    fmt::print("refused combinations:\n");
+    const std::vector<VariantInfo> walls = {
+        {"free", "open: nothing imposed"},
+        {"sticky", "v = 0 on the face (no-slip)"},
+        {"slip", "normal velocity removed, tangential kept"},
+        {"separate", "normal velocity removed only while pressing into the wall"}};
+    section("walls", "[boundary] x_min ... z_max, default; [[colliders]] wall", walls);
+    std::vector<std::string> refused;
     for (const auto& t : transfer_list()) {
       for (const auto& k : kernel_list()) {
-        if (auto r = unsupported_reason(t.name, k.name); !r.empty()) fmt::print("  {}\n", r);
+        if (auto r = unsupported_reason(t.name, k.name); !r.empty()) refused.push_back(r);
       }
     }
+    fmt::print("refused combinations:{}\n", refused.empty() ? " none" : "");
+    for (const auto& r : refused) fmt::print("  {}\n", r);
   }
-  return kExitOk;
-}
-
-int command_describe(const std::string& scene, const Overrides& overrides) {
-  const Scene s = load_scene(scene, overrides);
-  std::cout << "# " << s.source << " (after overrides)\n" << s.resolved << "\n";
   return kExitOk;
 }
 
@@ -126,6 +130,19 @@ int command_run(const RunRequest& request) {
   const bool sweep = transfers.size() > 1 || kernels.size() > 1;
   std::vector<std::pair<std::string, RunOutcome>> runs;
   int worst = kExitOk;
+  // --config: the recorded scene (and thread count, for identical output).
+  nlohmann::json recorded;
+  RunOptions options = request.options;
+  if (!request.config.empty()) {
+    recorded = read_summary(request.config);
+    if (options.threads == 0) options.threads = recorded_threads(recorded).value_or(0);
+  }
+  auto load = [&](const Overrides& o) {
+    return request.config.empty() ? load_scene(request.scene, o)
+                                  : load_recorded_scene(recorded, request.config, o);
+  };
+  options.progress = Progress::wanted(request.quiet);
+  const std::string label = request.config.empty() ? request.scene : request.config;
   for (const auto& t : transfers) {
     for (const auto& k : kernels) {
       Overrides o = request.overrides;
@@ -136,23 +153,26 @@ int command_run(const RunRequest& request) {
           sweep ? std::filesystem::path(request.out) / name : std::filesystem::path(request.out);
       RunOutcome r;
       try {
-        const Scene scene = load_scene(request.scene, o);
+        const Scene scene = load(o);
         if (sweep) {
           if (auto why = unsupported_reason(scene.transfer, scene.kernel); !why.empty()) {
             // A refused combination is a data point of a sweep, not a failure.
             r = write_invalid(dir, why, {{"transfer", t}, {"kernel", k}, {"dim", scene.dim}});
             runs.emplace_back(name, r);
-            fmt::print(stderr, "{:<24} refused: {}\n", name, why);
+            if (!request.quiet) fmt::print(stderr, "{:<24} refused: {}\n", name, why);
             continue;
           }
         }
-        r = run_scene(scene, dir, request.options);
+        options.label = sweep ? name : label;
+        r = run_scene(scene, dir, options);
       } catch (const InputError& e) {
         if (!sweep) throw;
         r = write_invalid(dir, e.what(), {{"transfer", t}, {"kernel", k}});
       }
-      fmt::print(stderr, "{:<24} {}{}{}\n", sweep ? name : request.scene, r.status,
-                 r.reason.empty() ? "" : ": ", r.reason);
+      if (!request.quiet) {
+        fmt::print(stderr, "{:<24} {}{}{}\n", sweep ? name : label, r.status,
+                   r.reason.empty() ? "" : ": ", r.reason);
+      }
       worst = std::max(worst, exit_status(r.status));
       runs.emplace_back(name, std::move(r));
     }

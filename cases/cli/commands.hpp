@@ -13,12 +13,15 @@ enum ExitStatus { kExitOk = 0, kExitError = 1, kExitInvalid = 2, kExitUnstable =
 
 struct RunRequest {
   std::string scene;
+  std::string config;  // a summary.json to re-run instead of `scene`
   Overrides overrides;
   std::string out;
   RunOptions options;
+  bool quiet = false;  // no progress line and no per-run status lines
 };
 
 int command_list(const std::string& only);
+// The scene's effective parameters (defaults included) after overrides, then its TOML.
 int command_describe(const std::string& scene, const Overrides& overrides);
 // Runs one scene, or, with --transfer all and/or --kernel all, every
 // combination into DIR/<transfer>-<kernel>/ plus DIR/runs.csv.

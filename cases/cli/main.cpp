@@ -1,30 +1,75 @@
 // mpmtb: the command-line front end of the MPM verification testbed.
 #include <fmt/format.h>
+#include <fmt/ranges.h>
+#include <unistd.h>
 #include <CLI/CLI.hpp>
 
 #include <exception>
 
+#include "boundary/walls.hpp"
 #include "commands.hpp"
 #include "core/errors.hpp"
+#include "core/registry.hpp"
+#include "models/registry.hpp"
 #include "suite/suite.hpp"
+
+#ifndef MPMTB_SOURCE_DIR
+#define MPMTB_SOURCE_DIR "."
+#endif
 
 namespace {
 
-// Options that override a scene, shared by `run` and `describe`.
+template <class List>
+std::string names(const List& list) {
+  std::vector<std::string> n;
+  for (const auto& v : list) n.push_back(v.name);
+  return fmt::format("{}", fmt::join(n, ", "));
+}
+
+// Options that override a scene, shared by `run` and `describe`. Their default
+// is the scene's own value (`mpmtb describe SCENE` prints it).
 void add_override_options(CLI::App& cmd, mpmtb::Overrides& o) {
-  cmd.add_option("--dim", o.dim, "dimension (1, 2 or 3; the scene lists which it supports)")
+  cmd.add_option("--dim", o.dim, "dimension: 1, 2 or 3 (default: the scene's [scene] dim)")
       ->check(CLI::Range(1, 3));
-  cmd.add_option("--transfer", o.transfer, "transfer scheme (see `mpmtb list`), or `all`");
-  cmd.add_option("--kernel", o.kernel, "kernel (linear, quadratic, cubic), or `all`");
-  cmd.add_option("--model", o.model, "constitutive model for every material");
-  cmd.add_option("--cells", o.cells, "cells along the scene's grid.length")
+  cmd.add_option("--transfer", o.transfer,
+                 fmt::format("transfer scheme: {}, or `all` for a sweep (default: the scene's "
+                             "[method] transfer)",
+                             names(mpmtb::transfer_list())));
+  cmd.add_option(
+      "--kernel", o.kernel,
+      fmt::format("kernel: {}, or `all` for a sweep (default: the scene's [method] kernel)",
+                  names(mpmtb::kernel_list())));
+  cmd.add_option("--model", o.model,
+                 fmt::format("constitutive model for every material: {} (default: each "
+                             "material's own)",
+                             names(mpmtb::model_list())));
+  cmd.add_option("--cells", o.cells,
+                 "cells along the scene's grid.length, integer >= 1 (default: [grid] cells)")
       ->check(CLI::PositiveNumber);
-  cmd.add_option("--ppc", o.ppc, "particles per cell per axis")->check(CLI::PositiveNumber);
-  auto* cfl = cmd.add_option("--cfl", o.cfl, "adaptive step dt = cfl dx / (c_p + max|v|)");
-  auto* dt = cmd.add_option("--dt", o.dt, "fixed time step");
+  cmd.add_option("--ppc", o.ppc, "particles per cell per axis, 1..16 (default: [grid] ppc, or 2)")
+      ->check(CLI::PositiveNumber);
+  auto* cfl = cmd.add_option("--cfl", o.cfl,
+                             "adaptive step dt = cfl dx / (c_p + max|v|), > 0 (replaces the "
+                             "scene's dt or cfl)");
+  auto* dt = cmd.add_option("--dt", o.dt, "fixed time step, > 0 (replaces the scene's dt or cfl)");
   cfl->excludes(dt);
-  cmd.add_option("--t-end", o.t_end, "end time");
-  cmd.add_option("--set", o.set, "override any scene field: key.path=value (repeatable)");
+  cmd.add_option("--t-end", o.t_end, "end time, > 0 (default: [time] t_end)");
+  cmd.add_option("--set", o.set,
+                 "override any scene field: key.path=value, the value in TOML, e.g. "
+                 "materials.steel.E=2e9 or bodies.0.velocity=[1,0] (repeatable)");
+}
+
+// `mpmtb render RUN_DIR ...`: hands the arguments to analysis/render.py.
+int forward_to_render(const std::vector<std::string>& args) {
+  const std::string script = std::string(MPMTB_SOURCE_DIR) + "/analysis/render.py";
+  std::vector<std::string> argv_s = {"/usr/bin/python3", script};
+  argv_s.insert(argv_s.end(), args.begin(), args.end());
+  std::vector<char*> argv;
+  for (auto& a : argv_s) argv.push_back(a.data());
+  argv.push_back(nullptr);
+  ::execv(argv[0], argv.data());
+  fmt::print(stderr, "mpmtb: cannot run {} {}\n", argv_s[0], script);
+  return mpmtb::kExitError;
 }
 
 // `mpmtb suite ...`: resumable parallel sweeps (cases/suite/).
@@ -48,30 +93,76 @@ CLI::App* add_suite_command(CLI::App& app, mpmtb::SuiteRequest& r) {
 }  // namespace
 
 int main(int argc, char** argv) {
-  CLI::App app{"mpmtb: Material Point Method verification testbed"};
+  CLI::App app{
+      "mpmtb: Material Point Method verification testbed.\n"
+      "Runs MPM variants (transfer x kernel x model) on canonical scenes and writes\n"
+      "series.csv and summary.json; see `mpmtb list` and `mpmtb <command> --help`.\n"
+      "Exit status: 0 ok, 1 program error, 2 invalid input, 3 unstable run."};
   app.require_subcommand(1);
 
   std::string list_only;
-  auto* list = app.add_subcommand("list", "list transfers, kernels, models and scenes");
-  list->add_option("what", list_only, "print only the names of: transfers|kernels|models|scenes")
+  auto* list = app.add_subcommand(
+      "list", "list transfers, kernels, models, walls and scenes, with citations");
+  list->add_option("what", list_only,
+                   "print only the names of one group: transfers|kernels|models|scenes")
       ->check(CLI::IsMember({"transfers", "kernels", "models", "scenes"}));
 
   mpmtb::RunRequest run_request;
-  auto* run = app.add_subcommand("run", "run a scene and write DIR/series.csv, DIR/summary.json");
-  run->add_option("scene", run_request.scene, "built-in scene name or scene file")->required();
+  auto* run = app.add_subcommand(
+      "run",
+      "run a scene and write DIR/series.csv and DIR/summary.json (and ParaView frames with "
+      "--frames-every/--frames-dt)");
+  auto* scene_opt = run->add_option("scene", run_request.scene,
+                                    "built-in scene name (see `mpmtb list`) or a "
+                                    "scene file (.toml)");
+  auto* config_opt = run->add_option(
+      "--config", run_request.config,
+      "re-run the configuration recorded in a summary.json (scene tree after every override, "
+      "and its thread count unless --threads is given); further overrides apply on top");
+  scene_opt->excludes(config_opt);
   add_override_options(*run, run_request.overrides);
-  run->add_option("--threads", run_request.options.threads, "OpenMP threads (0: default)")
-      ->check(CLI::NonNegativeNumber);
-  run->add_option("--out", run_request.out, "output folder")->required();
+  run->add_option("--threads", run_request.options.threads,
+                  "OpenMP threads, 0: OpenMP's default (OMP_NUM_THREADS or all cores)")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  run->add_option("--frames-every", run_request.options.frames.every,
+                  "write a particle frame every K steps (0: off) to DIR/frames/*.vtp, indexed "
+                  "by DIR/particles.pvd for ParaView")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  run->add_option("--frames-dt", run_request.options.frames.interval,
+                  "write a particle frame every T of simulated time (0: off); may be combined "
+                  "with --frames-every. The first and last states are always written")
+      ->check(CLI::NonNegativeNumber)
+      ->capture_default_str();
+  run->add_flag("--frames-grid", run_request.options.frames.grid,
+                "with frames, also write the grid (nodal mass, velocity) as DIR/frames/*.vti "
+                "and DIR/grid.pvd")
+      ->capture_default_str();
+  run->add_flag("-q,--quiet", run_request.quiet,
+                "no progress line and no status line (a progress line is drawn only when "
+                "stderr is a terminal)")
+      ->capture_default_str();
+  run->add_option("--out", run_request.out, "output folder (created; files in it are replaced)")
+      ->required();
 
   std::string describe_scene;
   mpmtb::Overrides describe_overrides;
-  auto* describe = app.add_subcommand("describe", "print a scene after overrides");
+  auto* describe = app.add_subcommand(
+      "describe", "print a scene's effective parameters (defaults marked) after overrides");
   describe->add_option("scene", describe_scene, "built-in scene name or scene file")->required();
   add_override_options(*describe, describe_overrides);
 
   mpmtb::SuiteRequest suite_request;
   auto* suite = add_suite_command(app, suite_request);
+  std::vector<std::string> render_args;
+  auto* render = app.add_subcommand(
+      "render",
+      "draw a run's frames to PNG/GIF (forwards to /usr/bin/python3 analysis/render.py; "
+      "`mpmtb render --help` lists its options)");
+  render->allow_extras();
+  render->prefix_command();
+  render->set_help_flag();  // --help goes to render.py
 
   try {
     app.parse(argc, argv);
@@ -83,6 +174,10 @@ int main(int argc, char** argv) {
     if (*list) return mpmtb::command_list(list_only);
     if (*describe) return mpmtb::command_describe(describe_scene, describe_overrides);
     if (*suite) return mpmtb::command_suite(suite_request);
+    if (*render) return forward_to_render(render->remaining());
+    if (run_request.scene.empty() && run_request.config.empty()) {
+      throw mpmtb::InputError("run: give a scene (name or file) or --config DIR/summary.json");
+    }
     return mpmtb::command_run(run_request);
   } catch (const mpmtb::InputError& e) {
     fmt::print(stderr, "mpmtb: invalid input: {}\n", e.what());

@@ -46,13 +46,16 @@ Real Parameters::required(const std::string& key, const Range& range) {
     throw InputError(
         fmt::format("{}: missing required parameter '{}' ({})", context_, key, range.text));
   }
+  read_[key] = {it->second, range.text, false};
   return checked(key, it->second, range);
 }
 
 Real Parameters::optional(const std::string& key, Real fallback, const Range& range) {
   asked_.insert(key);
   const auto it = values_.find(key);
-  return checked(key, it == values_.end() ? fallback : it->second, range);
+  const bool defaulted = it == values_.end();
+  read_[key] = {defaulted ? fallback : it->second, range.text, defaulted};
+  return checked(key, defaulted ? fallback : it->second, range);
 }
 
 void Parameters::reject_unknown() const {

@@ -36,6 +36,15 @@ class Parameters {
   // Throws InputError if a key was given that no reader asked for.
   void reject_unknown() const;
 
+  // What the readers asked for: the value used, its allowed range, and whether
+  // the value was the default (for `mpmtb describe`).
+  struct Read {
+    Real value = 0;
+    std::string range;
+    bool defaulted = false;
+  };
+  const std::map<std::string, Read>& read() const { return read_; }
+
   const std::string& context() const { return context_; }
   const std::map<std::string, Real>& values() const { return values_; }
   void set(const std::string& key, Real value) { values_[key] = value; }
@@ -45,6 +54,7 @@ class Parameters {
   std::string context_;
   std::map<std::string, Real> values_;
   std::set<std::string> asked_;
+  std::map<std::string, Read> read_;
 };
 
 }  // namespace mpmtb

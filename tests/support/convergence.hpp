@@ -24,7 +24,9 @@ inline Real run_error(const std::string& scene_name, const Overrides& o,
                                 scene.kernel, scene.cells);
   for (const auto& s : o.set) tag += fmt::format("_{}", std::hash<std::string>{}(s) % 100000);
   const auto dir = std::filesystem::temp_directory_path() / ("mpmtb_conv_" + tag);
-  const RunOutcome r = run_scene(scene, dir, {.threads = 1});
+  RunOptions options;
+  options.threads = 1;
+  const RunOutcome r = run_scene(scene, dir, options);
   if (r.status != "ok") return std::numeric_limits<Real>::infinity();
   return r.summary["error"][norm].get<Real>();
 }
