@@ -146,7 +146,7 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     }
   }
 
-  // Local damage update at fixed F; F itself is not changed.
+  // Damage update at fixed F (lap d, when l0 > 0, from the step); F is not changed.
   void project(Mat<Dim>& F, Real* q, Real dt) const {
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
