@@ -164,7 +164,8 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   drift.add(d0, 0, Vec3::Zero());
   series.rows.push_back(sample(d0));
 
-  const Real dx = s.grid.geo.dx, c = s.max_wave_speed();
+  const Real dx = s.grid.geo.dx;
+  Real c_max = 0;  // largest wave speed the CFL step used (hardening raises it)
   Real v_max = 0;
   for (const auto& v : s.particles.v) v_max = std::max(v_max, v.norm());
   // J range: of the total deformation at output times, and of det F_p (the
@@ -180,10 +181,15 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   Progress progress(options.label.empty() ? scene.name : options.label, options.progress);
 
   while (s.time < scene.t_end * (1 - 1e-12)) {
-    Real dt = scene.dt ? *scene.dt : *scene.cfl * dx / (c + v_max);
-    dt = std::min(dt, scene.t_end - s.time);
-    dt_min = std::min(dt_min, dt);
+    Real dt = scene.dt.value_or(0);
+    if (!scene.dt) {
+      const Real c = s.max_wave_speed();  // follows the current state
+      c_max = std::max(c_max, c);
+      dt = *scene.cfl * dx / (c + v_max);
+    }
+    dt_min = std::min(dt_min, dt);  // the scheme's steps, before the last one is cut
     dt_max = std::max(dt_max, dt);
+    dt = std::min(dt, scene.t_end - s.time);
     const auto t0 = std::chrono::steady_clock::now();
     const StepReport report = stepper->step(s, dt);
     step_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
@@ -242,6 +248,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   j["t"] = s.time;
   j["dt_min"] = dt_min;
   j["dt_max"] = dt_max;
+  if (!scene.dt) j["wave_speed_max"] = c_max;
   j["threads"] = omp_get_max_threads();
   j["wall_seconds"] = wall_seconds;
   j["step_seconds"] = step_seconds;

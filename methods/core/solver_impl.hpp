@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 
+#include "core/nonlocal.hpp"
 #include "core/solver.hpp"
 #include "core/stencil.hpp"
 #include "kernels/all.hpp"
@@ -109,6 +110,10 @@ class Solver final : public Stepper<Dim> {
     return {J_min, J_max, v_max, non_finite == n ? -1 : non_finite, outside == n ? -1 : outside};
   }
 
+  void nonlocal_update(State<Dim>& s) override {
+    nonlocal_.apply(s);
+  }
+
   Vec3 affine_angular_momentum(const State<Dim>& s) const override {
     Vec3 L = Vec3::Zero();
     if constexpr (Transfer::affine_momentum && Dim >= 2) {
@@ -188,6 +193,7 @@ class Solver final : public Stepper<Dim> {
   Parameters transfer_params_;
   std::vector<Mat<Dim>> tauV_;  // V0_p tau_p, from the materials
   std::vector<int> slab_of_, slab_start_, slab_order_;
+  NonlocalLaplacian<Dim, Kernel> nonlocal_;
 };
 
 template <int Dim, class Kernel, class Transfer>

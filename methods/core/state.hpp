@@ -3,6 +3,7 @@
 
 #include <functional>
 #include <memory>
+#include <span>
 #include <vector>
 
 #include "boundary/colliders.hpp"
@@ -39,9 +40,16 @@ struct State {
       material_particles[particles.material[p]].push_back(static_cast<int>(p));
     }
   }
+  // Largest wave speed over the materials in their current state (snow
+  // hardening raises it), for the CFL time step.
   Real max_wave_speed() const {
     Real c = 0;
-    for (const auto& m : materials) c = std::max(c, m->wave_speed());
+    for (std::size_t k = 0; k < materials.size(); ++k) {
+      const std::span<const int> ids = k < material_particles.size()
+                                           ? std::span<const int>(material_particles[k])
+                                           : std::span<const int>();
+      c = std::max(c, materials[k]->max_wave_speed(particles, ids));
+    }
     return c;
   }
 };

@@ -31,6 +31,7 @@ class Stepper {
     particles_to_grid(s, dt);
     update_grid(s, dt);
     StepReport r = grid_to_particles(s, dt);
+    nonlocal_update(s);
     constitutive_update(s, dt);
     s.time += dt;
     ++s.step;
@@ -41,6 +42,8 @@ class Stepper {
   virtual void particles_to_grid(State<Dim>& s, Real dt) = 0;
   virtual void update_grid(State<Dim>& s, Real dt) = 0;
   virtual StepReport grid_to_particles(State<Dim>& s, Real dt) = 0;
+  // Grid Laplacians that nonlocal models ask for (core/nonlocal.hpp).
+  virtual void nonlocal_update(State<Dim>& /*s*/) {}
   void constitutive_update(State<Dim>& s, Real dt) {
     for (std::size_t m = 0; m < s.materials.size(); ++m) {
       s.materials[m]->return_map(s.particles, s.material_particles[m], dt);

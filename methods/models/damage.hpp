@@ -7,8 +7,10 @@
 //       eta dd/dt = <(1 - d) D~ - (d - l0^2 lap d)>,  D~ = zeta <phi - 1>,
 //     here isotropic (no structural tensor) with phi = sigma_max / sigma_crit.
 //   Equation numbers are not given: they were not checked against the papers.
-// The l0^2 lap d regularization needs the grid (a nonlocal term); this model is
-// local, so it is left out and `l0` is not a parameter. Future work.
+// Length scale: the l0^2 lap d term needs the grid. The model asks for it
+// (laplacian_request) and the step writes lap d, computed on the grid by
+// core/nonlocal.hpp, into the state before return_map. l0 = 0 is the local
+// model exactly (no Laplacian is asked for, and project takes the local path).
 //
 // Energy: psi(F, d) = g(d) psi+(F) + psi-(F), g(d) = (1 - d)^2 (1 - k) + k.
 // Split (Amor, Marigo & Maurini 2009, volumetric-deviatoric, adapted to
@@ -36,13 +38,25 @@
 // Damage driver (project, after F is updated): sigma_max = the largest
 // principal value of the UNDAMAGED Cauchy stress tau(F, d = 0) / J,
 // phi = sigma_max / sigma_crit, D~ = zeta <phi - 1>,
-//   d <- min(1, d + dt/eta <(1 - d) D~ - d>),
-// so d never decreases, stays in [0, 1], and grows only once phi > 1. The
-// elastic energy released at fixed F, (g(d_old) - g(d_new)) psi+(F), is added
+//   d <- min(1, d + h <(1 - d) D~ - (d - l0^2 lap d)>),  h = dt/eta,
+// so d never decreases and stays in [0, 1]. With l0 = 0 (or a uniform d) it
+// grows only once phi > 1; with l0 > 0 damage also spreads from damaged
+// neighbours (lap d > 0) over a distance of order l0: in a region with D~ = 0
+// the steady profile solves d = l0^2 d'', d ~ exp(-|x| / l0).
+// The explicit diffusion h l0^2 lap d would be unstable for h l0^2 4 Dim/dx^2
+// > 2, i.e. l0 above about one cell with the default eta; the Laplacian's
+// diagonal a = l0^2 2 Dim / dx^2 (from the step) is therefore taken
+// implicitly, d_new - d = h (R - a (d_new - d)) with R the explicit rate, i.e.
+// h -> h / (1 + h a): first order in dt like the explicit update, the same
+// steady state, and the grid modes stay bounded for any l0 with h <= 2.
+// The elastic energy released at fixed F, (g(d_old) - g(d_new)) psi+(F), is added
 // to the dissipated energy, keeping kinetic + strain + gravity + dissipated.
 // Parameters: E, nu, density; sigma_crit > 0 (required); zeta > 0 (1);
-// eta > 0 (1e-3, a time scale: smaller = faster); k in [0, 1) (1e-6).
-// State per particle: {damage d, dissipated energy per unit initial volume}.
+// eta > 0 (1e-3, a time scale: smaller = faster); k in [0, 1) (1e-6);
+// l0 >= 0 (0.02, a length: 1.3 cells of the pinned block, dx = 1/64; it
+// should span 1 to 2 cells of the grid it runs on; 0 = local).
+// State per particle: {damage d, dissipated energy per unit initial volume,
+// lap d and the diagonal 2 Dim / dx^2, both written by the step}.
 #pragma once
 
 #include <Eigen/Eigenvalues>
@@ -60,26 +74,35 @@ template <int Dim>
 class Damage final : public ModelBase<Dim, Damage<Dim>> {
  public:
   static constexpr std::string_view model_name = "damage";
-  enum StateIndex { kDamage = 0, kDissipated = 1 };
+  enum StateIndex { kDamage = 0, kDissipated = 1, kLapDamage = 2, kLapDiagonal = 3 };
 
   explicit Damage(Parameters& params)
       : c_(ElasticConstants::read(params)),
         sigma_crit_(params.required("sigma_crit", Range::positive())),
         zeta_(params.optional("zeta", 1, Range::positive())),
         eta_(params.optional("eta", 1e-3, Range::positive())),
-        k_(params.optional("k", 1e-6, Range::half_open(0, 1))) {}
+        k_(params.optional("k", 1e-6, Range::half_open(0, 1))),
+        l0_(params.optional("l0", 0.02, Range::non_negative())) {}
 
   std::string_view name() const override { return model_name; }
   Real density() const override { return c_.density; }
   Real wave_speed() const override { return c_.wave_speed(); }
-  int state_size() const override { return 2; }
+  int state_size() const override { return 4; }
   void initial_state(Real* q) const override {
     q[kDamage] = 0;
     q[kDissipated] = 0;
+    q[kLapDamage] = 0;
+    q[kLapDiagonal] = 0;
   }
-  std::vector<std::string> state_names() const override { return {"damage", "dissipated"}; }
+  std::vector<std::string> state_names() const override {
+    return {"damage", "dissipated", "lap_damage", "lap_diagonal"};
+  }
+  LaplacianRequest laplacian_request() const override {
+    return l0_ > 0 ? LaplacianRequest{kDamage, kLapDamage} : LaplacianRequest{};
+  }
 
   Real sigma_crit() const { return sigma_crit_; }
+  Real l0() const { return l0_; }
   Real degradation(Real d) const { return (1 - d) * (1 - d) * (1 - k_) + k_; }
 
   // The tensile (degraded) and compressive (kept) parts of the energy.
@@ -123,7 +146,7 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     }
   }
 
-  // Local damage update at fixed F; F itself is not changed.
+  // Damage update at fixed F (lap d, when l0 > 0, from the step); F is not changed.
   void project(Mat<Dim>& F, Real* q, Real dt) const {
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
@@ -131,9 +154,15 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     // D~ > 0 exactly when sigma_max > sigma_crit (no rounding of the quotient).
     const Real excess = max_principal_stress(F) - sigma_crit_;
     const Real D = excess > 0 ? zeta_ * excess / sigma_crit_ : Real(0);
-    const Real rate = std::max(Real(0), (1 - d_old) * D - d_old);
+    Real drive = (1 - d_old) * D - d_old, h = dt / eta_;
+    if (l0_ > 0) {  // the nonlocal term; the local path is untouched otherwise
+      const Real l2 = l0_ * l0_;
+      drive += l2 * q[kLapDamage];
+      h /= 1 + h * l2 * q[kLapDiagonal];
+    }
+    const Real rate = std::max(Real(0), drive);
     if (!(rate > 0)) return;  // also guards against NaN
-    const Real d_new = std::min(Real(1), d_old + dt / eta_ * rate);
+    const Real d_new = std::min(Real(1), d_old + h * rate);
     if (!(d_new > d_old)) return;
     q[kDissipated] += (degradation(d_old) - degradation(d_new)) * split(F).plus;
     q[kDamage] = d_new;
@@ -157,7 +186,7 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   }
 
   ElasticConstants c_;
-  Real sigma_crit_, zeta_, eta_, k_;
+  Real sigma_crit_, zeta_, eta_, k_, l0_;
 };
 
 }  // namespace mpmtb

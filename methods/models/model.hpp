@@ -15,6 +15,15 @@
 
 namespace mpmtb {
 
+// What a nonlocal model asks of the step (core/nonlocal.hpp): the grid
+// Laplacian of its state variable q[source], written to q[target] together
+// with the grid operator's diagonal magnitude 2 Dim / dx^2 in q[target + 1],
+// after G2P and before return_map.
+struct LaplacianRequest {
+  int source = -1, target = -1;
+  bool active() const { return source >= 0; }
+};
+
 template <int Dim>
 class ConstitutiveModel {
  public:
@@ -29,6 +38,15 @@ class ConstitutiveModel {
   virtual void initial_state(Real* /*q*/) const {}
   // Names of the internal variables, in order (for output).
   virtual std::vector<std::string> state_names() const { return {}; }
+  // Nonlocal models only (see LaplacianRequest); local models ask for nothing.
+  virtual LaplacianRequest laplacian_request() const { return {}; }
+  // The largest wave speed over the particles `ids` in their current state
+  // (hardening raises it), for the adaptive time step; the model's wave_speed()
+  // unless the stiffness depends on the state.
+  virtual Real max_wave_speed(const Particles<Dim>& /*particles*/,
+                              std::span<const int> /*ids*/) const {
+    return wave_speed();
+  }
 
   // Per-particle formulas, for tests and diagnostics.
   virtual Real energy_density(const Mat<Dim>& F, const Real* q) const = 0;   // psi(F)

@@ -31,11 +31,16 @@
 //
 // An inverted trial F (det < 0) would give J_P < 0; the step loop reports
 // J <= 0 after G2P as unstable before that matters.
-// wave_speed() is that of the unhardened material (mu0, lambda0): the CFL time
-// step does not follow the hardening (exp(xi (1 - J_P)) grows when J_P < 1).
+// wave_speed() is that of the unhardened material (mu0, lambda0). The adaptive
+// time step uses max_wave_speed(): both moduli scale by the hardening
+// h = exp(xi (1 - J_P)), so c = c0 sqrt(h), largest where J_P is smallest
+// (one pass over the particles for min J_P; exp is monotone).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
+#include <limits>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -67,6 +72,12 @@ class Snow final : public ModelBase<Dim, Snow<Dim>> {
     q[kDissipated] = 0;
   }
   std::vector<std::string> state_names() const override { return {"J_P", "dissipated"}; }
+  Real max_wave_speed(const Particles<Dim>& particles, std::span<const int> ids) const override {
+    if (ids.empty()) return wave_speed();
+    Real J_P_min = std::numeric_limits<Real>::infinity();
+    for (const int p : ids) J_P_min = std::min(J_P_min, particles.state_of(p)[kJP]);
+    return wave_speed() * std::sqrt(hardening(J_P_min));
+  }
   // F_p is F_E: the total volume ratio is J = J_E J_P.
   Real total_J(const Mat<Dim>& F, const Real* q) const override { return F.determinant() * q[0]; }
 

@@ -42,9 +42,13 @@ std::map<std::string, Real> With(const std::string& key, Real value) {
   return v;
 }
 
+// The local model (l0 = 0) unless l0 is given: these tests call project on
+// single particles, with no grid to give lap d (damage_length_test.cpp has l0 > 0).
 template <int Dim>
 Damage<Dim> MakeDamage(const std::map<std::string, Real>& values = Valid()) {
-  Parameters p("materials.test", values);
+  auto local = values;
+  local.emplace("l0", 0);
+  Parameters p("materials.test", local);
   Damage<Dim> m(p);
   p.reject_unknown();
   return m;
@@ -94,7 +98,7 @@ TYPED_TEST(DamageTest, StressIsEnergyGradientAtFixedDamage) {
   constexpr int Dim = TestFixture::Dim;
   const ConstitutiveModel<Dim>& m = this->m_;
   for (const Real d : {0.0, 0.3, 1.0}) {
-    const Real q[2] = {d, 0};
+    const Real q[4] = {d, 0, 0, 0};
     for (int s = 0; s < 20; ++s) {
       const Mat<Dim> F = RandomF<Dim>(this->gen_);
       const Mat<Dim> P_fd = FiniteDifferenceP<Dim>(m, F, q);
@@ -110,7 +114,7 @@ TYPED_TEST(DamageTest, RotationsAreStressFreeAndObjective) {
   constexpr int Dim = TestFixture::Dim;
   const auto& m = this->m_;
   for (const Real d : {0.0, 0.3, 1.0}) {
-    const Real q[2] = {d, 0};
+    const Real q[4] = {d, 0, 0, 0};
     for (int s = 0; s < 10; ++s) {
       const Mat<Dim> R = s == 0 ? Mat<Dim>::Identity() : RandomRotation<Dim>(this->gen_);
       SCOPED_TRACE(::testing::Message() << "R =\n" << R);
@@ -124,7 +128,7 @@ TYPED_TEST(DamageTest, RotationsAreStressFreeAndObjective) {
       EXPECT_NEAR(m.max_principal_stress(R * F), m.max_principal_stress(F), 1e-10 * kE);
     }
   }
-  const Real q0[2] = {0, 0};
+  const Real q0[4] = {0, 0, 0, 0};
   EXPECT_GT(m.P(Mat<Dim>::Identity() * 1.1, q0).norm(), 1e-2 * kE);
 }
 
@@ -132,7 +136,7 @@ TYPED_TEST(DamageTest, SplitIsExactAndNonNegative) {
   constexpr int Dim = TestFixture::Dim;
   const auto& nh = this->nh_;
   const auto& m = this->m_;
-  const Real q0[2] = {0, 0};
+  const Real q0[4] = {0, 0, 0, 0};
   int tension = 0, compression = 0;
   for (int s = 0; s < 200; ++s) {
     const Mat<Dim> F = RandomF<Dim>(this->gen_);
@@ -160,7 +164,7 @@ TYPED_TEST(DamageTest, DamageIsMonotoneAndBounded) {
   constexpr int Dim = TestFixture::Dim;
   const auto m = MakeDamage<Dim>(With("eta", 1e-2));
   std::uniform_real_distribution<Real> u(0, 1);
-  Real q[2] = {-1, -1};
+  Real q[4] = {-1, -1, -1, -1};
   m.initial_state(q);
   ASSERT_TRUE(q[0] == 0 && q[1] == 0);
   Real d_max_seen = 0;
@@ -182,7 +186,7 @@ TYPED_TEST(DamageTest, DamageIsMonotoneAndBounded) {
   }
   EXPECT_GT(d_max_seen, 0.1) << "the history should damage the particle";
   // One huge step (dt / eta = 100) far past failure: clamped to exactly 1, then absorbing.
-  Real q1[2] = {0, 0};
+  Real q1[4] = {0, 0, 0, 0};
   for (int i = 0; i < 2; ++i) {
     Mat<Dim> F = Uniaxial<Dim>(1.5);
     m.project(F, q1, 1);
@@ -209,7 +213,7 @@ TYPED_TEST(DamageTest, NoDamageBelowThreshold) {
     return lo;
   };
   const Real below = stretch_at(0.99);
-  Real q[2] = {0, 0};
+  Real q[4] = {0, 0, 0, 0};
   for (int step = 0; step < 10000; ++step) {
     Mat<Dim> F = Uniaxial<Dim>(below);
     m.project(F, q, 1e-3);
@@ -222,7 +226,7 @@ TYPED_TEST(DamageTest, NoDamageBelowThreshold) {
   EXPECT_GT(q[0], 0);
   // The driver is the UNDAMAGED stress: at d = 0.2 and 1.5 sigma_crit undamaged
   // (0.96 sigma_crit degraded), (1 - d) D~ - d = 0.8 * 0.5 - 0.2 > 0: d grows.
-  Real q2[2] = {0.2, 0};
+  Real q2[4] = {0.2, 0, 0, 0};
   F = Uniaxial<Dim>(stretch_at(1.5));
   EXPECT_NEAR(m.max_principal_stress(F), 1.5 * kSigmaCrit, 1e-9 * kSigmaCrit);
   m.project(F, q2, 1e-3);
@@ -231,7 +235,7 @@ TYPED_TEST(DamageTest, NoDamageBelowThreshold) {
 
 TEST(DamageOnset, StartsExactlyAtCriticalStressIn1D) {
   const auto m = MakeDamage<1>();
-  Real q[2] = {0, 0};
+  Real q[4] = {0, 0, 0, 0};
   int first_damaged = -1, first_over = -1;
   for (int step = 1; step <= 2000; ++step) {
     const Real stretch = 1 + 1e-4 * step;
@@ -280,7 +284,7 @@ TYPED_TEST(DamageTest, FullyDamagedCarriesNoTensionButResistsCompression) {
 TYPED_TEST(DamageTest, EnergyBudgetAtFixedF) {
   constexpr int Dim = TestFixture::Dim;
   const auto m = MakeDamage<Dim>(With("eta", 1e-2));
-  Real q[2] = {0, 0};
+  Real q[4] = {0, 0, 0, 0};
   Real released = 0;
   for (int step = 0; step < 200; ++step) {
     Mat<Dim> F = Uniaxial<Dim>(1.3) + 0.02 * RandomMatrix<Dim>(this->gen_);
@@ -314,17 +318,16 @@ TEST(DamageParameters, ValidParametersAreAcceptedAndStateIsNamed) {
   all.insert({{"zeta", 2}, {"eta", 0.1}, {"k", 0}});
   const auto m = MakeDamage<3>(all);
   EXPECT_EQ(m.name(), "damage");
-  EXPECT_EQ(m.state_size(), 2);
-  EXPECT_EQ(m.state_names(), (std::vector<std::string>{"damage", "dissipated"}));
+  EXPECT_EQ(m.state_size(), 4);
+  EXPECT_EQ(m.state_names(),
+            (std::vector<std::string>{"damage", "dissipated", "lap_damage", "lap_diagonal"}));
   EXPECT_DOUBLE_EQ(m.density(), kRho);
 }
 
 TEST(DamageParameters, InvalidValuesAreRejectedByName) {
-  const std::vector<std::pair<std::string, Real>>
-      bad = {{"sigma_crit", 0}, {"sigma_crit", -1}, {"eta", 0},  {"eta", -1e-3},
-             {"zeta", 0},       {"k", 1},           {"k", -0.1}, {"E", 0},
-             {"nu", 0.5},       {"density", -1},    {"l0", 0.1}};  // l0: the nonlocal length is not
-                                                                   // part of this local model
+  const std::vector<std::pair<std::string, Real>> bad = {
+      {"sigma_crit", 0}, {"sigma_crit", -1}, {"eta", 0},  {"eta", -1e-3},  {"zeta", 0},  {"k", 1},
+      {"k", -0.1},       {"E", 0},           {"nu", 0.5}, {"density", -1}, {"l0", -0.01}};
   for (const auto& [key, value] : bad) ExpectRejected(With(key, value), key);
   auto missing = Valid();
   missing.erase("sigma_crit");
