@@ -13,10 +13,10 @@
 namespace mpmtb {
 
 struct RunOptions {
-  int threads = 0;        // 0: OpenMP's default
-  FrameOptions frames;    // ParaView frames (off by default)
-  bool progress = false;  // draw a progress line on stderr (see Progress::wanted)
-  std::string label;      // names the run on the progress line
+  int threads = 0;           // 0: OpenMP's default
+  FrameOptions frames = {};  // ParaView frames (off by default)
+  bool progress = false;     // draw a progress line on stderr (see Progress::wanted)
+  std::string label = {};    // names the run on the progress line
 };
 
 struct RunOutcome {
