@@ -16,14 +16,27 @@ void add_override_options(CLI::App& cmd, mpmtb::Overrides& o) {
   cmd.add_option("--transfer", o.transfer, "transfer scheme (see `mpmtb list`), or `all`");
   cmd.add_option("--kernel", o.kernel, "kernel (linear, quadratic, cubic), or `all`");
   cmd.add_option("--model", o.model, "constitutive model for every material");
-  cmd.add_option("--cells", o.cells, "cells along the scene's grid.length")
-      ->check(CLI::PositiveNumber);
-  cmd.add_option("--ppc", o.ppc, "particles per cell per axis")->check(CLI::PositiveNumber);
+  // Ranges of --cells and --ppc are checked with the scene (grid.cells, grid.ppc).
+  cmd.add_option("--cells", o.cells, "cells along the scene's grid.length");
+  cmd.add_option("--ppc", o.ppc, "particles per cell per axis");
   auto* cfl = cmd.add_option("--cfl", o.cfl, "adaptive step dt = cfl dx / (c_p + max|v|)");
   auto* dt = cmd.add_option("--dt", o.dt, "fixed time step");
   cfl->excludes(dt);
   cmd.add_option("--t-end", o.t_end, "end time");
   cmd.add_option("--set", o.set, "override any scene field: key.path=value (repeatable)");
+}
+
+// A message on one line: control characters from user strings are escaped.
+std::string one_line(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
+    } else {
+      out += c;
+    }
+  }
+  return out;
 }
 
 }  // namespace
@@ -42,7 +55,7 @@ int main(int argc, char** argv) {
   run->add_option("scene", run_request.scene, "built-in scene name or scene file")->required();
   add_override_options(*run, run_request.overrides);
   run->add_option("--threads", run_request.options.threads, "OpenMP threads (0: default)")
-      ->check(CLI::NonNegativeNumber);
+      ->check(CLI::Range(0, 4096));
   run->add_option("--out", run_request.out, "output folder")->required();
 
   std::string describe_scene;
@@ -54,18 +67,20 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : mpmtb::kExitInvalid;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // One line, like every other input error.
+    fmt::print(stderr, "mpmtb: invalid input: command line: {}\n", one_line(e.what()));
+    return mpmtb::kExitInvalid;
   }
   try {
     if (*list) return mpmtb::command_list(list_only);
     if (*describe) return mpmtb::command_describe(describe_scene, describe_overrides);
     return mpmtb::command_run(run_request);
   } catch (const mpmtb::InputError& e) {
-    fmt::print(stderr, "mpmtb: invalid input: {}\n", e.what());
+    fmt::print(stderr, "mpmtb: invalid input: {}\n", one_line(e.what()));
     return mpmtb::kExitInvalid;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "mpmtb: error: {}\n", e.what());
+    fmt::print(stderr, "mpmtb: error: {}\n", one_line(e.what()));
     return mpmtb::kExitError;
   }
 }
