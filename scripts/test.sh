@@ -10,3 +10,5 @@ ctest -L 'unit|verification|e2e' --output-on-failure -j "$(nproc)"
 cd ..
 # Sanitizer stage: the unit tests again, built with ASan + UBSan in ./build-asan.
 bash scripts/sanitize.sh
+# Bounded coverage-guided fuzz of the scene parser (libFuzzer; skipped without clang).
+bash scripts/fuzz.sh 200000 60
