@@ -102,13 +102,46 @@ Real gyration_radius(const State<Dim>& s, const Diagnostics& d) {
 }
 
 // The reason a step's report marks the run unstable, or empty.
-std::string failure_reason(const StepReport& r) {
+std::string failure_reason(const StepReport& r, Real J_floor) {
   if (r.non_finite >= 0)
     return fmt::format("non-finite value (NaN/Inf) at particle {}", r.non_finite);
   if (r.J_min <= 0) return fmt::format("J <= 0 (J_min = {:.3g}): inverted element", r.J_min);
+  if (r.J_min <= J_floor) {
+    return fmt::format("J <= checks.J_floor = {:.3g} (J_min = {:.3g}): element crushed", J_floor,
+                       r.J_min);
+  }
   if (r.outside >= 0) return fmt::format("particle {} left the domain", r.outside);
   return {};
 }
+
+// Compares each step with the CFL limit of the current state, dt_cfl = dx /
+// (c_p + max|v|) (CFL number 1; Courant, Friedrichs & Lewy 1928), and warns
+// once on stderr when the step exceeds it.
+struct CflCheck {
+  Real ratio_max = 0;  // max over the run of dt / dt_cfl
+  long first_step = -1;
+  Real first_t = 0;
+
+  void check(Real dt, Real dt_cfl, long step, Real t, const std::string& source) {
+    const Real ratio = dt / dt_cfl;
+    if (ratio > ratio_max) ratio_max = ratio;
+    if (ratio > 1 && first_step < 0) {
+      first_step = step;
+      first_t = t;
+      fmt::print(stderr,
+                 "mpmtb: warning: {}: dt = {:.4g} exceeds the CFL limit dx / (c_p + max|v|) = "
+                 "{:.4g} at step {} (t = {:.4g}); the explicit step may be unstable\n",
+                 source, dt, dt_cfl, step, t);
+    }
+  }
+  void add_to(nlohmann::json& j) const {
+    j["dt_cfl_ratio_max"] = ratio_max;
+    if (first_step >= 0) {
+      j["dt_cfl_exceeded"] = {
+          {"ratio_max", ratio_max}, {"first_step", first_step}, {"first_t", first_t}};
+    }
+  }
+};
 
 nlohmann::json base_summary(const Scene& scene) {
   nlohmann::json j;
@@ -172,6 +205,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   // elastic part for plasticity) at every step, which is what inverts.
   Real J_min = d0.J_min, J_max = d0.J_max, J_elastic_min = d0.J_min, J_elastic_max = d0.J_max;
   Real dt_min = std::numeric_limits<Real>::infinity(), dt_max = 0;
+  CflCheck cfl_check;
   Real next_output = scene.output_interval;
   std::string status = "ok", reason;
   double step_seconds = 0;
@@ -181,21 +215,22 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   Progress progress(options.label.empty() ? scene.name : options.label, options.progress);
 
   while (s.time < scene.t_end * (1 - 1e-12)) {
+    const Real c = s.max_wave_speed();  // follows the current state (snow hardening)
     Real dt = scene.dt.value_or(0);
     if (!scene.dt) {
-      const Real c = s.max_wave_speed();  // follows the current state
       c_max = std::max(c_max, c);
       dt = *scene.cfl * dx / (c + v_max);
     }
     dt_min = std::min(dt_min, dt);  // the scheme's steps, before the last one is cut
     dt_max = std::max(dt_max, dt);
+    cfl_check.check(dt, dx / (c + v_max), s.step, s.time, scene.source);
     dt = std::min(dt, scene.t_end - s.time);
     const auto t0 = std::chrono::steady_clock::now();
     const StepReport report = stepper->step(s, dt);
     step_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
     v_max = report.v_max;
     progress.update(s.time / scene.t_end, s.step);
-    reason = failure_reason(report);
+    reason = failure_reason(report, scene.J_floor);
     if (!reason.empty()) {
       status = "unstable";
       break;
@@ -249,6 +284,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   j["dt_min"] = dt_min;
   j["dt_max"] = dt_max;
   if (!scene.dt) j["wave_speed_max"] = c_max;
+  cfl_check.add_to(j);
   j["threads"] = omp_get_max_threads();
   j["wall_seconds"] = wall_seconds;
   j["step_seconds"] = step_seconds;
@@ -266,11 +302,16 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   }
 
   write_atomically(out_dir / "series.csv", series.render());
-  write_atomically(out_dir / "summary.json", j.dump(2) + "\n");
+  write_atomically(out_dir / "summary.json", dump_json(j));
   return {status, reason, j};
 }
 
 }  // namespace
+
+std::string dump_json(const nlohmann::json& j) {
+  // Invalid UTF-8 (say, in a file name) is replaced, never a reason to lose a summary.
+  return j.dump(2, ' ', false, nlohmann::json::error_handler_t::replace) + "\n";
+}
 
 nlohmann::json toml_to_json(const toml::node& node) {
   if (const auto* t = node.as_table()) {
@@ -293,13 +334,18 @@ nlohmann::json toml_to_json(const toml::node& node) {
 RunOutcome run_scene(const Scene& scene, const std::filesystem::path& out_dir,
                      const RunOptions& options) {
   if (options.threads > 0) omp_set_num_threads(options.threads);
-  switch (scene.dim) {
-    case 1:
-      return run_dim<1>(scene, out_dir, options);
-    case 2:
-      return run_dim<2>(scene, out_dir, options);
-    default:
-      return run_dim<3>(scene, out_dir, options);
+  try {
+    switch (scene.dim) {
+      case 1:
+        return run_dim<1>(scene, out_dir, options);
+      case 2:
+        return run_dim<2>(scene, out_dir, options);
+      default:
+        return run_dim<3>(scene, out_dir, options);
+    }
+  } catch (const InputError& e) {
+    // Set-up errors (seeding, references, refused combinations) name the scene too.
+    throw InputError(fmt::format("{}: {}", scene.source, e.what()));
   }
 }
 
@@ -308,7 +354,7 @@ RunOutcome write_invalid(const std::filesystem::path& out_dir, const std::string
   nlohmann::json j = context;
   j["status"] = "invalid";
   j["reason"] = reason;
-  write_atomically(out_dir / "summary.json", j.dump(2) + "\n");
+  write_atomically(out_dir / "summary.json", dump_json(j));
   return {"invalid", reason, j};
 }
 

@@ -35,5 +35,7 @@ RunOutcome write_invalid(const std::filesystem::path& out_dir, const std::string
                          const nlohmann::json& context);
 
 nlohmann::json toml_to_json(const toml::node& node);
+// JSON text of a summary, with invalid UTF-8 replaced rather than thrown on.
+std::string dump_json(const nlohmann::json& j);
 
 }  // namespace mpmtb

@@ -64,12 +64,13 @@ void read_method(TableReader& top, Scene& s) {
   s.kernel = m.choice("kernel", names_of(kernel_list()));
   m.finish();
   // A table named after a transfer holds that transfer's parameters ([flip] alpha = ...).
+  // Tables of the other transfers are kept for switching with --transfer, but
+  // must hold numbers too.
   for (const auto& t : transfer_list()) {
     const toml::table* params = top.table_or_null(t.name);
-    if (t.name == s.transfer) {
-      s.transfer_params = Parameters(t.name);
-      if (params) s.transfer_params = TableReader(*params, t.name).numbers_as_parameters({});
-    }
+    Parameters read(t.name);
+    if (params) read = TableReader(*params, t.name).numbers_as_parameters({});
+    if (t.name == s.transfer) s.transfer_params = read;
   }
 }
 
@@ -104,6 +105,7 @@ void read_physics_and_walls(TableReader& top, Scene& s) {
   if (const toml::table* c = top.table_or_null("checks")) {
     TableReader r(*c, "checks");
     s.energy_limit = r.number_or("energy_limit", s.energy_limit, Range::open(1, 1e300));
+    s.J_floor = r.number_or("J_floor", s.J_floor, Range::half_open(0, 1));
     r.finish();
   }
 }
@@ -210,6 +212,31 @@ void read_reference(TableReader& top, Scene& s) {
   r.finish();
 }
 
+// UTF-8 (RFC 3629): scene trees are recorded in summary.json, which must be valid JSON text.
+bool is_valid_utf8(const std::string& text) {
+  for (std::size_t i = 0; i < text.size();) {
+    const auto c = static_cast<unsigned char>(text[i]);
+    const int extra = c < 0x80           ? 0
+                      : (c >> 5) == 0x6  ? 1
+                      : (c >> 4) == 0xE  ? 2
+                      : (c >> 3) == 0x1E ? 3
+                                         : -1;
+    if (extra < 0 || i + extra >= text.size()) return false;
+    std::uint32_t code = extra == 0 ? c : c & (0x3F >> extra);
+    for (int k = 1; k <= extra; ++k) {
+      const auto d = static_cast<unsigned char>(text[i + k]);
+      if ((d >> 6) != 0x2) return false;
+      code = (code << 6) | (d & 0x3F);
+    }
+    const std::uint32_t min_code[] = {0, 0x80, 0x800, 0x10000};
+    if (code < min_code[extra] || code > 0x10FFFF || (code >= 0xD800 && code <= 0xDFFF)) {
+      return false;
+    }
+    i += 1 + extra;
+  }
+  return true;
+}
+
 }  // namespace
 
 Vec3 BodySpec::rotation_center() const {
@@ -247,6 +274,9 @@ toml::table parse_scene_text(const std::string& text, const std::string& source)
 }
 
 void apply_set(toml::table& tree, const std::string& assignment) {
+  if (!is_valid_utf8(assignment)) {
+    throw InputError("--set: the assignment is not valid UTF-8 text");
+  }
   const auto eq = assignment.find('=');
   if (eq == std::string::npos || eq == 0 || eq + 1 == assignment.size()) {
     throw InputError(fmt::format("--set '{}': expected key.path=value", assignment));
@@ -365,6 +395,10 @@ Scene load_scene(const std::string& name_or_path, const Overrides& o) {
     text = buf.str();
     source = name_or_path;
   }
+  return scene_from_text(text, source, o);
+}
+
+Scene scene_from_text(const std::string& text, const std::string& source, const Overrides& o) {
   toml::table tree = parse_scene_text(text, source);
   try {
     apply_overrides(tree, o);

@@ -63,6 +63,7 @@ struct Scene {
   std::string reference;  // analytic reference kind, empty for none
   Parameters reference_params;
   Real energy_limit = 2;  // unstable when K + S exceeds this times the energy put in
+  Real J_floor = 0;       // unstable when a particle's J = det F falls to this or below
   toml::table resolved;   // the whole tree after overrides, recorded in summaries
 
   Real dx() const { return length / cells; }
@@ -92,6 +93,8 @@ Scene read_scene(const toml::table& tree, const std::string& source);
 
 // Loads a built-in scene by name or a scene file by path, then applies overrides.
 Scene load_scene(const std::string& name_or_path, const Overrides& o = {});
+// The same from the scene's text; every message starts with `source`.
+Scene scene_from_text(const std::string& text, const std::string& source, const Overrides& o = {});
 
 struct BuiltinScene {
   std::string name;

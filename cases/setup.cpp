@@ -1,5 +1,7 @@
 #include "setup.hpp"
 
+#include <fmt/format.h>
+
 #include <cmath>
 
 #include "core/errors.hpp"
@@ -30,6 +32,17 @@ bool pinned_at(const Scene& scene, const Vec3& x) {
   return false;
 }
 
+// Bodies may not overlap: a lattice point inside two of them would silently
+// take the first one's material and velocity (cases/README.md).
+[[noreturn]] void throw_overlap(const Scene& scene, const BodySpec& a, const BodySpec& b,
+                                const Vec3& x) {
+  const auto index = [&](const BodySpec& body) { return &body - scene.bodies.data(); };
+  throw InputError(fmt::format(
+      "bodies[{}] and bodies[{}] overlap at ({:.6g}, {:.6g}, {:.6g}); bodies may touch but not "
+      "overlap",
+      index(a), index(b), x[0], x[1], x[2]));
+}
+
 template <int Dim>
 void seed_particles(const Scene& scene, State<Dim>& s) {
   const GridGeometry<Dim>& geo = s.grid.geo;
@@ -46,12 +59,16 @@ void seed_particles(const Scene& scene, State<Dim>& s) {
       x[a] = geo.lo[a] + (static_cast<Real>(rest % n[a]) + Real(0.5)) * h;
       rest /= n[a];
     }
+    const BodySpec* owner = nullptr;
     for (const auto& body : scene.bodies) {
       if (!body.contains(x, Dim)) continue;
-      const Real rho = s.materials[body.material]->density();
-      s.particles.add(head<Dim>(x), rigid_velocity<Dim>(body, x), rho * volume, volume,
-                      body.material, pinned_at<Dim>(scene, x));
-      break;
+      if (owner) throw_overlap(scene, *owner, body, x);
+      owner = &body;
+    }
+    if (owner) {
+      const Real rho = s.materials[owner->material]->density();
+      s.particles.add(head<Dim>(x), rigid_velocity<Dim>(*owner, x), rho * volume, volume,
+                      owner->material, pinned_at<Dim>(scene, x));
     }
   }
   if (s.particles.size() == 0) throw InputError("bodies: no particle lies inside any body");

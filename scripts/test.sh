@@ -7,3 +7,8 @@ cd "$(dirname "$0")/.."
 bash scripts/build.sh
 cd build
 ctest -L 'unit|verification|e2e' --output-on-failure -j "$(nproc)"
+cd ..
+# Sanitizer stage: the unit tests again, built with ASan + UBSan in ./build-asan.
+bash scripts/sanitize.sh
+# Bounded coverage-guided fuzz of the scene parser (libFuzzer; skipped without clang).
+bash scripts/fuzz.sh 200000 60

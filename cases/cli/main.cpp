@@ -31,6 +31,7 @@ std::string names(const List& list) {
 void add_override_options(CLI::App& cmd, mpmtb::Overrides& o) {
   cmd.add_option("--dim", o.dim, "dimension: 1, 2 or 3 (default: the scene's [scene] dim)")
       ->check(CLI::Range(1, 3));
+  // Ranges of --cells and --ppc are checked with the scene (grid.cells, grid.ppc).
   cmd.add_option("--transfer", o.transfer,
                  fmt::format("transfer scheme: {}, or `all` for a sweep (default: the scene's "
                              "[method] transfer)",
@@ -44,10 +45,8 @@ void add_override_options(CLI::App& cmd, mpmtb::Overrides& o) {
                              "material's own)",
                              names(mpmtb::model_list())));
   cmd.add_option("--cells", o.cells,
-                 "cells along the scene's grid.length, integer >= 1 (default: [grid] cells)")
-      ->check(CLI::PositiveNumber);
-  cmd.add_option("--ppc", o.ppc, "particles per cell per axis, 1..16 (default: [grid] ppc, or 2)")
-      ->check(CLI::PositiveNumber);
+                 "cells along the scene's grid.length, integer >= 1 (default: [grid] cells)");
+  cmd.add_option("--ppc", o.ppc, "particles per cell per axis, 1..16 (default: [grid] ppc, or 2)");
   auto* cfl = cmd.add_option("--cfl", o.cfl,
                              "adaptive step dt = cfl dx / (c_p + max|v|), > 0 (replaces the "
                              "scene's dt or cfl)");
@@ -90,6 +89,19 @@ CLI::App* add_suite_command(CLI::App& app, mpmtb::SuiteRequest& r) {
   return cmd;
 }
 
+// A message on one line: control characters from user strings are escaped.
+std::string one_line(const std::string& text) {
+  std::string out;
+  for (char c : text) {
+    if (static_cast<unsigned char>(c) < 0x20) {
+      out += fmt::format("\\x{:02x}", static_cast<unsigned char>(c));
+    } else {
+      out += c;
+    }
+  }
+  return out;
+}
+
 }  // namespace
 
 int main(int argc, char** argv) {
@@ -123,7 +135,7 @@ int main(int argc, char** argv) {
   add_override_options(*run, run_request.overrides);
   run->add_option("--threads", run_request.options.threads,
                   "OpenMP threads, 0: OpenMP's default (OMP_NUM_THREADS or all cores)")
-      ->check(CLI::NonNegativeNumber)
+      ->check(CLI::Range(0, 4096))
       ->capture_default_str();
   run->add_option("--frames-every", run_request.options.frames.every,
                   "write a particle frame every K steps (0: off) to DIR/frames/*.vtp, indexed "
@@ -167,8 +179,10 @@ int main(int argc, char** argv) {
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
-    const int code = app.exit(e);
-    return code == 0 ? 0 : mpmtb::kExitInvalid;
+    if (e.get_exit_code() == 0) return app.exit(e);  // --help
+    // One line, like every other input error.
+    fmt::print(stderr, "mpmtb: invalid input: command line: {}\n", one_line(e.what()));
+    return mpmtb::kExitInvalid;
   }
   try {
     if (*list) return mpmtb::command_list(list_only);
@@ -180,10 +194,10 @@ int main(int argc, char** argv) {
     }
     return mpmtb::command_run(run_request);
   } catch (const mpmtb::InputError& e) {
-    fmt::print(stderr, "mpmtb: invalid input: {}\n", e.what());
+    fmt::print(stderr, "mpmtb: invalid input: {}\n", one_line(e.what()));
     return mpmtb::kExitInvalid;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "mpmtb: error: {}\n", e.what());
+    fmt::print(stderr, "mpmtb: error: {}\n", one_line(e.what()));
     return mpmtb::kExitError;
   }
 }

@@ -2,14 +2,11 @@
 // allowed; the command line exits non-zero and writes nothing.
 #include <gtest/gtest.h>
 
-#include <array>
-#include <cstdio>
 #include <filesystem>
 #include <fstream>
 
-#include <unistd.h>
-
 #include "core/errors.hpp"
+#include "support/cli.hpp"
 #include "support/scenes.hpp"
 
 namespace mpmtb {
@@ -109,22 +106,10 @@ TEST(Scene, SetReachesEveryField) {
   EXPECT_EQ(s.gravity[1], -9.81);
 }
 
-// The program itself: exit status 2, the field named on stderr, no files.
-struct Cli {
-  int status;
-  std::string err;
-};
-Cli run_cli(const std::string& args) {
-  // One capture file per call: ctest runs tests in parallel processes.
-  static int calls = 0;
-  const auto log =
-      std::filesystem::temp_directory_path() /
-      ("mpmtb_cli_stderr_" + std::to_string(::getpid()) + "_" + std::to_string(calls++));
-  const int rc = std::system((std::string(MPMTB_CLI) + " " + args + " 2>" + log.string()).c_str());
-  std::ifstream in(log);
-  std::string err((std::istreambuf_iterator<char>(in)), {});
-  return {WEXITSTATUS(rc), err};
-}
+// The program itself: exit status 2, the field named on stderr, no files
+// (tests/unit/input_test.cpp goes through every class of bad input).
+using Cli = testing::CliResult;
+using testing::run_cli;
 
 TEST(Cli, BadInputExitsWithStatusTwoAndNamesTheField) {
   const auto out =
