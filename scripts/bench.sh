@@ -41,7 +41,8 @@ measure() {
   : >"$rates"
   for _ in $(seq "$REPEATS"); do
     rm -rf "$run"
-    OMP_NUM_THREADS=$threads "$exe" run "$scene" --threads "$threads" "$@" --out "$run" >/dev/null 2>&1
+    OMP_NUM_THREADS=$threads "$exe" run "$scene" --threads "$threads" "$@" --out "$run" >/dev/null 2>&1 ||
+      { echo "bench: case $name failed: $exe run $scene $*" >&2; exit 1; }
     field "$run/summary.json" particle_steps_per_second >>"$rates"
   done
   local median

@@ -186,10 +186,15 @@ class Solver final : public Stepper<Dim> {
     const auto& x = s.particles.x;
     const long n = static_cast<long>(x.size());
     const Real inv_dx = 1 / geo.dx;
-    std::array<int, Dim> lo, hi;
-    lo.fill(std::numeric_limits<int>::max());
-    hi.fill(std::numeric_limits<int>::min());
+    int lo[Dim], hi[Dim];
+    std::fill_n(lo, Dim, std::numeric_limits<int>::max());
+    std::fill_n(hi, Dim, std::numeric_limits<int>::min());
     first_.resize(n);
+    // Min and max are exact, so the box does not depend on the thread count.
+#pragma omp parallel for schedule(static) reduction(min         \
+                                                    : lo[:Dim]) \
+    reduction(max                                               \
+              : hi[:Dim]) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       for (int a = 0; a < Dim; ++a) {
         // As in Stencil, clamped so that a stray particle cannot index out of range.
@@ -214,6 +219,7 @@ class Solver final : public Stepper<Dim> {
     }
     block_of_.resize(n);
     block_start_.assign(kColours * per_colour + 1, 0);
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       int colour = 0, index = 0;
       for (int a = 0; a < kColouredAxes; ++a) {
@@ -222,8 +228,8 @@ class Solver final : public Stepper<Dim> {
         index = index * half[a] + b / 2;
       }
       block_of_[p] = colour * per_colour + index;
-      ++block_start_[block_of_[p] + 1];
     }
+    for (long p = 0; p < n; ++p) ++block_start_[block_of_[p] + 1];
     for (std::size_t k = 1; k < block_start_.size(); ++k) block_start_[k] += block_start_[k - 1];
     block_order_.resize(n);
     fill_.assign(block_start_.begin(), block_start_.end() - 1);
