@@ -107,6 +107,11 @@ struct Grid {
     for (int a = 0; a + 1 < Dim; ++a) rows *= std::max(0, active_hi[a] - active_lo[a] + 1);
     return active_hi[Dim - 1] < active_lo[Dim - 1] ? 0 : rows;
   }
+  // Number of nodes in the active box.
+  long active_nodes() const {
+    const long rows = active_rows();
+    return rows ? rows * (active_hi[Dim - 1] - active_lo[Dim - 1] + 1) : 0;
+  }
   // First node and length of active row r (0 <= r < active_rows()).
   std::pair<long, int> active_row(long r) const {
     long node = active_lo[Dim - 1];

@@ -56,7 +56,7 @@ class Solver final : public Stepper<Dim> {
   void update_grid(State<Dim>& s, Real dt) override {
     Grid<Dim>& g = s.grid;
     const long rows = g.active_rows();
-    const bool parallel = rows * g.active_row(0).second >= kParallelMinimum;
+    const bool parallel = g.active_nodes() >= kParallelMinimum;
     const Vec<Dim> gravity = s.gravity;
 #pragma omp parallel for schedule(static) if (parallel)
     for (long r = 0; r < rows; ++r) {
@@ -163,7 +163,7 @@ class Solver final : public Stepper<Dim> {
   // is zero everywhere before the scatter, at a cost that follows the particles.
   static void clear_active_box(Grid<Dim>& g) {
     const long rows = g.active_rows();
-#pragma omp parallel for schedule(static) if (rows * g.active_row(0).second >= kParallelMinimum)
+#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
     for (long r = 0; r < rows; ++r) {
       const auto [first, count] = g.active_row(r);
       std::fill_n(g.m.begin() + first, count, Real(0));
