@@ -1,7 +1,9 @@
 // Uniform background grid: geometry and the nodal arrays of one step.
 #pragma once
 
+#include <algorithm>
 #include <cstdint>
+#include <utility>
 #include <vector>
 
 #include "types.hpp"
@@ -80,6 +82,11 @@ struct Grid {
   std::vector<Vec<Dim>> v;           // v_i  velocity after the grid update
   std::vector<Vec<Dim>> v_old;       // v_i before forces (kept for FLIP-like transfers)
   std::vector<std::uint8_t> pinned;  // nodes held at rest by pinned particles
+  // The box of node indices [active_lo, active_hi] (inclusive) outside which
+  // every nodal field is zero: the solver clears, updates and sweeps only this
+  // box, so the grid's cost follows the region the particles occupy, not the
+  // domain. Empty (lo > hi) on a fresh grid.
+  std::array<int, Dim> active_lo{}, active_hi{};
 
   explicit Grid(const GridGeometry<Dim>& g = {}) : geo(g) {
     const auto n = static_cast<std::size_t>(g.node_count());
@@ -89,8 +96,32 @@ struct Grid {
     v.assign(n, Vec<Dim>::Zero());
     v_old.assign(n, Vec<Dim>::Zero());
     pinned.assign(n, 0);
+    active_lo.fill(0);
+    active_hi.fill(-1);
   }
   std::size_t size() const { return m.size(); }
+
+  // Number of rows of the active box: runs of consecutive nodes along the last axis.
+  long active_rows() const {
+    long rows = 1;
+    for (int a = 0; a + 1 < Dim; ++a) rows *= std::max(0, active_hi[a] - active_lo[a] + 1);
+    return active_hi[Dim - 1] < active_lo[Dim - 1] ? 0 : rows;
+  }
+  // Number of nodes in the active box.
+  long active_nodes() const {
+    const long rows = active_rows();
+    return rows ? rows * (active_hi[Dim - 1] - active_lo[Dim - 1] + 1) : 0;
+  }
+  // First node and length of active row r (0 <= r < active_rows()).
+  std::pair<long, int> active_row(long r) const {
+    long node = active_lo[Dim - 1];
+    for (int a = Dim - 2; a >= 0; --a) {
+      const long extent = active_hi[a] - active_lo[a] + 1;
+      node += (active_lo[a] + r % extent) * geo.strides()[a];
+      r /= extent;
+    }
+    return {node, active_hi[Dim - 1] - active_lo[Dim - 1] + 1};
+  }
 };
 
 }  // namespace mpmtb

@@ -4,11 +4,15 @@
 #pragma once
 
 #include <algorithm>
+#include <array>
 #include <cmath>
+#include <cstdint>
+#include <limits>
 
 #include "core/nonlocal.hpp"
 #include "core/solver.hpp"
 #include "core/stencil.hpp"
+#include "core/tensor_transfer.hpp"
 #include "kernels/all.hpp"
 
 namespace mpmtb {
@@ -17,6 +21,9 @@ template <int Dim, class Kernel, class Transfer>
 class Solver final : public Stepper<Dim> {
   using Policy = typename Transfer::template Policy<Dim, Kernel>;
   using StencilT = Stencil<Dim, Kernel>;
+  // The policy's transfers as sums over the stencil (core/tensor_transfer.hpp),
+  // or, for a policy that does not declare them, its per-node math.
+  static constexpr bool kTensorPath = has_tensor_path<Policy>();
 
  public:
   Solver(Parameters& transfer_params) : transfer_params_(transfer_params) {}
@@ -27,19 +34,21 @@ class Solver final : public Stepper<Dim> {
   void particles_to_grid(State<Dim>& s, Real dt) override {
     (void)dt;  // forces are kept apart from momentum; the grid update integrates them
     compute_stresses(s);
-    clear_grid(s.grid);
-    bin_particles_into_slabs(s);
+    clear_active_box(s.grid);
+    bin_particles_into_blocks(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
-    // Slabs of Kernel::support cells along x: the stencils of slabs two apart never
-    // overlap, so even slabs scatter in parallel, then odd ones. No locks, and the
-    // summation order (and so the result) does not depend on the thread count.
+    // Blocks of Kernel::support cells along the first two axes: the stencils of
+    // blocks two apart never overlap, so the blocks of one colour (the parity of
+    // their block coordinates) scatter in parallel, one colour after the other.
+    // No locks, and the summation order (and so the result) does not depend on
+    // the thread count.
     const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
-    for (int phase = 0; phase < 2; ++phase) {
-      const int n_slabs = static_cast<int>(slab_start_.size()) - 1;
+    const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
+    for (int colour = 0; colour < kColours; ++colour) {
 #pragma omp parallel for schedule(dynamic, 1) if (parallel)
-      for (int slab = phase; slab < n_slabs; slab += 2) {
-        for (int k = slab_start_[slab]; k < slab_start_[slab + 1]; ++k) {
-          scatter_particle(s, policy, slab_order_[k]);
+      for (int b = colour * per_colour; b < (colour + 1) * per_colour; ++b) {
+        for (int k = block_start_[b]; k < block_start_[b + 1]; ++k) {
+          scatter_particle(s, policy, block_order_[k]);
         }
       }
     }
@@ -47,28 +56,35 @@ class Solver final : public Stepper<Dim> {
 
   void update_grid(State<Dim>& s, Real dt) override {
     Grid<Dim>& g = s.grid;
-    const long n = static_cast<long>(g.size());
+    const long rows = g.active_rows();
+    const bool parallel = g.active_nodes() >= kParallelMinimum;
     const Vec<Dim> gravity = s.gravity;
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-    for (long i = 0; i < n; ++i) g.f[i] += g.m[i] * gravity;
+#pragma omp parallel for schedule(static) if (parallel)
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      for (long i = first; i < first + count; ++i) g.f[i] += g.m[i] * gravity;
+    }
     s.walls.fold(g);
     Real rx = 0, ry = 0, rz = 0;  // reaction of the pinned nodes
-#pragma omp parallel for schedule(static) reduction(+ : rx, ry, rz) if (n >= kParallelMinimum)
-    for (long i = 0; i < n; ++i) {
-      if (g.m[i] > 0) {
-        const Real inv_m = 1 / g.m[i];
-        const Vec<Dim> v_old = g.p[i] * inv_m;
-        if constexpr (Transfer::needs_old_velocity) g.v_old[i] = v_old;
-        // Symplectic Euler: v_i^{n+1} = v_i^n + dt f_i / m_i (f_i includes m_i g).
-        g.v[i] = v_old + dt * inv_m * g.f[i];
-        if (g.pinned[i]) {
-          const Vec3 reaction = to3<Dim>(-g.m[i] * g.v[i]);
-          rx += reaction[0], ry += reaction[1], rz += reaction[2];
+#pragma omp parallel for schedule(static) reduction(+ : rx, ry, rz) if (parallel)
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      for (long i = first; i < first + count; ++i) {
+        if (g.m[i] > 0) {
+          const Real inv_m = 1 / g.m[i];
+          const Vec<Dim> v_old = g.p[i] * inv_m;
+          if constexpr (Transfer::needs_old_velocity) g.v_old[i] = v_old;
+          // Symplectic Euler: v_i^{n+1} = v_i^n + dt f_i / m_i (f_i includes m_i g).
+          g.v[i] = v_old + dt * inv_m * g.f[i];
+          if (g.pinned[i]) {
+            const Vec3 reaction = to3<Dim>(-g.m[i] * g.v[i]);
+            rx += reaction[0], ry += reaction[1], rz += reaction[2];
+            g.v[i].setZero();
+          }
+        } else {
+          g.v_old[i].setZero();
           g.v[i].setZero();
         }
-      } else {
-        g.v_old[i].setZero();
-        g.v[i].setZero();
       }
     }
     s.pin_impulse += Vec3(rx, ry, rz);
@@ -91,9 +107,15 @@ class Solver final : public Stepper<Dim> {
     for (long p = 0; p < n; ++p) {
       const StencilT st(P.x[p], g.geo);
       typename Policy::Gather gather;
-      st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
-        policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
-      });
+      if constexpr (kTensorPath) {
+        gather =
+            policy.gather_from(TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(
+                st, g.geo, g.v.data(), g.v_old.data()));
+      } else {
+        st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
+          policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
+        });
+      }
       policy.finish(gather, P, static_cast<int>(p), dt);
       // Failure detection, fused into this loop so that it costs nothing extra.
       const Real J = P.F[p].determinant();
@@ -142,36 +164,81 @@ class Solver final : public Stepper<Dim> {
     }
   }
 
-  static void clear_grid(Grid<Dim>& g) {
-    const long n = static_cast<long>(g.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-    for (long i = 0; i < n; ++i) {
-      g.m[i] = 0;
-      g.p[i].setZero();
-      g.f[i].setZero();
-      g.pinned[i] = 0;
+  // Zeroes every nodal field over the active box of the previous step: the grid
+  // is zero everywhere before the scatter, at a cost that follows the particles.
+  static void clear_active_box(Grid<Dim>& g) {
+    const long rows = g.active_rows();
+#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      std::fill_n(g.m.begin() + first, count, Real(0));
+      std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
+      std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
+      std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
+      std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
+      std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
     }
   }
 
-  // Stable counting sort of particle ids by slab along x.
-  void bin_particles_into_slabs(const State<Dim>& s) {
-    const auto& geo = s.grid.geo;
-    constexpr int width = Kernel::support;
-    const int n_slabs = (geo.cells[0] + 2 * GridGeometry<Dim>::pad) / width + 1;
+  // Sets the grid's active box to the nodes the particles' stencils reach, plus
+  // GridGeometry::pad layers (the mirrors of the wall ghosts), and sorts the
+  // particle ids by colour, then block (a stable counting sort: particle order
+  // within a block).
+  void bin_particles_into_blocks(State<Dim>& s) {
+    Grid<Dim>& g = s.grid;
+    const auto& geo = g.geo;
+    constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
     const auto& x = s.particles.x;
-    slab_of_.resize(x.size());
-    slab_start_.assign(n_slabs + 1, 0);
-    for (std::size_t p = 0; p < x.size(); ++p) {
-      const Real cell = std::floor((x[p][0] - geo.lo[0]) / geo.dx) + GridGeometry<Dim>::pad;
-      const int slab = std::clamp(static_cast<int>(cell) / width, 0, n_slabs - 1);
-      slab_of_[p] = slab;
-      ++slab_start_[slab + 1];
+    const long n = static_cast<long>(x.size());
+    const Real inv_dx = 1 / geo.dx;
+    int lo[Dim], hi[Dim];
+    std::fill_n(lo, Dim, std::numeric_limits<int>::max());
+    std::fill_n(hi, Dim, std::numeric_limits<int>::min());
+    first_.resize(n);
+    // Min and max are exact, so the box does not depend on the thread count.
+#pragma omp parallel for schedule(static) reduction(min         \
+                                                    : lo[:Dim]) \
+    reduction(max                                               \
+              : hi[:Dim]) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      for (int a = 0; a < Dim; ++a) {
+        // As in Stencil, clamped so that a stray particle cannot index out of range.
+        const Real xi =
+            std::clamp((x[p][a] - geo.lo[a]) * inv_dx, Real(-pad), Real(geo.cells[a] + pad));
+        const int f = StencilT::first_index(xi) + pad;
+        lo[a] = std::min(lo[a], f);
+        hi[a] = std::max(hi[a], f);
+        if (a < kColouredAxes) first_[p][a] = f;
+      }
     }
-    for (int k = 0; k < n_slabs; ++k) slab_start_[k + 1] += slab_start_[k];
-    slab_order_.resize(x.size());
-    std::vector<int> fill(slab_start_.begin(), slab_start_.end() - 1);
-    for (std::size_t p = 0; p < x.size(); ++p)
-      slab_order_[fill[slab_of_[p]]++] = static_cast<int>(p);
+    for (int a = 0; a < Dim; ++a) {
+      g.active_lo[a] = n ? std::max(0, lo[a] - pad) : 0;
+      g.active_hi[a] = n ? std::min(geo.nodes(a) - 1, hi[a] + S - 1 + pad) : -1;
+    }
+    // Blocks of S cells from the lowest first node, half of them per colour and axis.
+    std::array<int, kColouredAxes> half{};
+    int per_colour = 1;
+    for (int a = 0; a < kColouredAxes; ++a) {
+      half[a] = n ? ((hi[a] - lo[a]) / S + 2) / 2 : 1;
+      per_colour *= half[a];
+    }
+    block_of_.resize(n);
+    block_start_.assign(kColours * per_colour + 1, 0);
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      int colour = 0, index = 0;
+      for (int a = 0; a < kColouredAxes; ++a) {
+        const int b = (first_[p][a] - lo[a]) / S;
+        colour |= (b & 1) << a;
+        index = index * half[a] + b / 2;
+      }
+      block_of_[p] = colour * per_colour + index;
+    }
+    for (long p = 0; p < n; ++p) ++block_start_[block_of_[p] + 1];
+    for (std::size_t k = 1; k < block_start_.size(); ++k) block_start_[k] += block_start_[k - 1];
+    block_order_.resize(n);
+    fill_.assign(block_start_.begin(), block_start_.end() - 1);
+    for (long p = 0; p < n; ++p) block_order_[fill_[block_of_[p]]++] = static_cast<int>(p);
   }
 
   void scatter_particle(State<Dim>& s, const Policy& policy, int p) {
@@ -179,20 +246,43 @@ class Solver final : public Stepper<Dim> {
     Grid<Dim>& g = s.grid;
     const StencilT st(P.x[p], g.geo);
     const auto src = policy.prepare(P, p, tauV_[p]);
-    const bool pinned = P.pinned[p];
-    const bool has_body_force = static_cast<bool>(s.body_force);
-    const Vec<Dim> mb =
-        has_body_force ? Vec<Dim>(P.m[p] * s.body_force(P, p, s.time)) : Vec<Dim>::Zero();
-    st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
-      policy.scatter(src, w, grad, d, g.m[node], g.p[node], g.f[node]);
-      if (has_body_force) g.f[node] += w * mb;
-      if (pinned && w > 0) g.pinned[node] = 1;
-    });
+    Real* m = g.m.data();
+    Vec<Dim>* mom = g.p.data();
+    Vec<Dim>* f = g.f.data();
+    if constexpr (kTensorPath) {
+      ScatterForm<Dim> form;
+      policy.scatter_form(src, form);
+      if (s.body_force) {
+        form.alpha.template segment<Dim>(ScatterForm<Dim>::f) +=
+            P.m[p] * s.body_force(P, p, s.time);
+      }
+      TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(st, g.geo, form, m, mom,
+                                                                           f);
+    } else if (!s.body_force) {
+      st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
+        policy.scatter(src, w, grad, d, m[node], mom[node], f[node]);
+      });
+    } else {
+      const Vec<Dim> mb = P.m[p] * s.body_force(P, p, s.time);
+      st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
+        policy.scatter(src, w, grad, d, m[node], mom[node], f[node]);
+        f[node] += w * mb;
+      });
+    }
+    if (P.pinned[p]) {
+      st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+        if (w > 0) g.pinned[node] = 1;
+      });
+    }
   }
 
   Parameters transfer_params_;
   std::vector<Mat<Dim>> tauV_;  // V0_p tau_p, from the materials
-  std::vector<int> slab_of_, slab_start_, slab_order_;
+  // P2G colouring: blocks over the first two axes (one in 1D), 2^axes colours.
+  static constexpr int kColouredAxes = Dim >= 2 ? 2 : 1;
+  static constexpr int kColours = 1 << kColouredAxes;
+  std::vector<std::array<int, kColouredAxes>> first_;  // first stencil node per coloured axis
+  std::vector<int> block_of_, block_start_, block_order_, fill_;
   NonlocalLaplacian<Dim, Kernel> nonlocal_;
 };
 

@@ -37,44 +37,46 @@ struct Stencil {
   Real dw[Dim][S];     // 1D derivatives dN/dx per axis (physical units)
   Real d[Dim][S];      // 1D offsets x_i - x_p per axis
 
+  // Index (unpadded) of the first node of the support along one axis, for a
+  // position xi in cell units.
+  static int first_index(Real xi) { return static_cast<int>(std::floor(xi - Real(0.5) * (S - 2))); }
+
   Stencil(const Vec<Dim>& xp, const GridGeometry<Dim>& g) {
     const Real inv_dx = 1 / g.dx;
     for (int a = 0; a < Dim; ++a) {
       const Real xi = (xp[a] - g.lo[a]) * inv_dx;  // position in cell units
       // First node of the support: floor(xi) for support 2, floor(xi - 1/2) for 3, floor(xi) - 1
       // for 4.
-      const int first = static_cast<int>(std::floor(xi - Real(0.5) * (S - 2)));
-      for (int k = 0; k < S; ++k) {
-        const Real r = xi - (first + k);
-        w[a][k] = Kernel::N(r);
-        dw[a][k] = Kernel::dN(r) * inv_dx;
-        d[a][k] = -r * g.dx;
+      const int first = first_index(xi);
+      if constexpr (requires(Real * out) { Kernel::weights(Real(1), out, out); }) {
+        // The kernel's own branch-free form for the whole support (same values).
+        const Real r0 = xi - first;
+        Kernel::weights(r0, w[a], dw[a]);
+        for (int k = 0; k < S; ++k) {
+          dw[a][k] *= inv_dx;
+          d[a][k] = -(r0 - k) * g.dx;
+        }
+      } else {
+        for (int k = 0; k < S; ++k) {
+          const Real r = xi - (first + k);
+          w[a][k] = Kernel::N(r);
+          dw[a][k] = Kernel::dN(r) * inv_dx;
+          d[a][k] = -r * g.dx;
+        }
       }
       base_node += static_cast<long>(first + GridGeometry<Dim>::pad) * g.strides()[a];
     }
   }
 
-  // Calls f(node, w_ip, grad w_ip, x_i - x_p) for every node of the stencil.
+  // Calls f(node, w_ip, grad w_ip, x_i - x_p) for every node of the stencil, last
+  // axis fastest. The products of the 1D factors are built axis by axis, so a node
+  // costs one multiplication for w_ip and Dim for grad w_ip (dropped by the
+  // compiler when the callback does not read the gradient).
   template <class Fn>
   void for_each_node(const GridGeometry<Dim>& g, Fn&& f) const {
-    const auto& stride = g.strides();
-    for (int n = 0; n < count; ++n) {
-      const auto& k = offsets[n];
-      long node = base_node;
-      Real weight = 1;
-      Vec<Dim> grad, dpos;
-      for (int a = 0; a < Dim; ++a) {
-        node += k[a] * stride[a];
-        weight *= w[a][k[a]];
-        dpos[a] = d[a][k[a]];
-        Real g_a = dw[a][k[a]];
-        for (int b = 0; b < Dim; ++b) {
-          if (b != a) g_a *= w[b][k[b]];
-        }
-        grad[a] = g_a;
-      }
-      f(node, weight, grad, dpos);
-    }
+    Real grad_part[Dim];
+    Vec<Dim> dpos;
+    loop_axis<0>(g.strides(), base_node, Real(1), grad_part, dpos, f);
   }
 
   // D_p = sum_i w_ip (x_i - x_p)(x_i - x_p)^T. Diagonal for tensor-product kernels
@@ -87,6 +89,27 @@ struct Stencil {
       D[a] = s;
     }
     return D;
+  }
+
+ private:
+  // Axis A of the tensor-product loop. On entry `weight` is prod_{b<A} w_b and
+  // grad_part[a] = dw_a prod_{b<A, b!=a} w_b for a < A.
+  template <int A, class Fn>
+  void loop_axis(const std::array<long, Dim>& stride, long node, Real weight, const Real* grad_part,
+                 Vec<Dim>& dpos, Fn& f) const {
+    if constexpr (A == Dim) {
+      Vec<Dim> grad;
+      for (int a = 0; a < Dim; ++a) grad[a] = grad_part[a];
+      f(node, weight, static_cast<const Vec<Dim>&>(grad), static_cast<const Vec<Dim>&>(dpos));
+    } else {
+      for (int k = 0; k < S; ++k) {
+        Real part[Dim];
+        for (int a = 0; a < A; ++a) part[a] = grad_part[a] * w[A][k];
+        part[A] = weight * dw[A][k];
+        dpos[A] = d[A][k];
+        loop_axis<A + 1>(stride, node + k * stride[A], weight * w[A][k], part, dpos, f);
+      }
+    }
   }
 };
 

@@ -9,8 +9,12 @@
 
 namespace mpmtb {
 
-// Precision of every field. Verification needs double.
-using Real = double;
+// Precision of every field. Verification needs double (the default); a
+// `float` build (cmake -DMPMTB_REAL=float) is for throughput measurements.
+#ifndef MPMTB_REAL
+#define MPMTB_REAL double
+#endif
+using Real = MPMTB_REAL;
 
 template <int Dim>
 using Vec = Eigen::Matrix<Real, Dim, 1>;

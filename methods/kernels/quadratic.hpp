@@ -34,6 +34,18 @@ struct QuadraticKernel {
     if (a < Real(1.5)) return -s * (Real(1.5) - a);
     return 0;
   }
+
+  // N and dN at the support's 3 nodes, r_k = r0 - k with r0 in [1/2, 3/2) the
+  // offset to the first node: the branches of N resolved once (same formulas).
+  static void weights(Real r0, Real* w, Real* dw) {
+    const Real b = Real(1.5) - r0, r1 = r0 - 1, c = r0 - Real(0.5);
+    w[0] = Real(0.5) * b * b;
+    dw[0] = -b;
+    w[1] = Real(0.75) - r1 * r1;
+    dw[1] = -2 * r1;
+    w[2] = Real(0.5) * c * c;
+    dw[2] = c;
+  }
 };
 
 }  // namespace mpmtb

@@ -22,6 +22,16 @@ class AffineMoments {
       : D_inv_(Kernel::constant_inertia ? 1 / (Kernel::inertia * dx * dx) : 0) {}
 
   // The vector q_ip with C_p = sum_i v_i q_ip^T: D^-1 w (x_i - x_p), or grad w.
+  // C_p from the stencil sums B = sum w v_i (x_i - x_p)^T and G = sum v_i grad w^T.
+  M from_sums(const M& B, const M& G) const {
+    if constexpr (Kernel::constant_inertia) {
+      return B * D_inv_;
+    } else {
+      return G;
+    }
+  }
+  Real D_inv() const { return D_inv_; }
+
   V weight_moment(Real w, const V& grad, const V& d) const {
     if constexpr (Kernel::constant_inertia) {
       return (w * D_inv_) * d;

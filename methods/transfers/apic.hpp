@@ -13,6 +13,7 @@
 
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
+#include "core/tensor_transfer.hpp"
 #include "transfers/affine.hpp"
 
 namespace mpmtb {
@@ -41,11 +42,29 @@ class ApicPolicy {
     f_i -= s.tauV * grad;
   }
 
+  // The base solver's fast path (core/tensor_transfer.hpp): the same math as
+  // scatter() and gather(), as sums over the stencil.
+  using TensorPath = ApicPolicy;
+  static constexpr TensorTerms scatter_terms{.moment = true, .gradient = true};
+  void scatter_form(const Source& s, ScatterForm<Dim>& form) const {
+    using F = ScatterForm<Dim>;
+    form.alpha[F::m] = s.m;
+    form.alpha.template segment<Dim>(F::p) = s.mv;
+    for (int a = 0; a < Dim; ++a) {
+      form.gamma[a].template segment<Dim>(F::p) = s.mC.col(a);
+      form.beta[a].template segment<Dim>(F::f) = -s.tauV.col(a);
+    }
+  }
+
   struct Gather {
     V v = V::Zero();
     M C = M::Zero();
     M grad_v = M::Zero();
   };
+  static constexpr TensorTerms gather_terms{.moment = Kernel::constant_inertia, .gradient = true};
+  Gather gather_from(const GatherSums<Dim>& sums) const {
+    return {sums.v, moments_.from_sums(sums.B, sums.G), sums.G};
+  }
   void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
     g.v += w * v_i;
     g.C += v_i * moments_.weight_moment(w, grad, d).transpose();

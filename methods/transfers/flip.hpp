@@ -28,6 +28,11 @@ class FlipPolicy : public PicPolicy<Dim, Kernel> {
     V dv = V::Zero();  // sum w (v_i - v_i_old): the grid's velocity increment
     M grad_v = M::Zero();
   };
+  using TensorPath = FlipPolicy;
+  static constexpr TensorTerms gather_terms{.gradient = true, .old = true};
+  Gather gather_from(const GatherSums<Dim>& sums) const {
+    return {sums.v, sums.v - sums.v_old, sums.G};
+  }
   void gather(Gather& g, Real w, const V& grad, const V&, const V& v_i, const V& v_old_i) const {
     g.v += w * v_i;
     g.dv += w * (v_i - v_old_i);

@@ -32,10 +32,33 @@ class MlsPolicy : public ApicPolicy<Dim, Kernel> {
     f_i -= s.tauV * this->moments_.weight_moment(w, grad, d);
   }
 
+  // The base solver's fast path (core/tensor_transfer.hpp): the same math as
+  // scatter() and gather(), as sums over the stencil.
+  using TensorPath = MlsPolicy;
+  static constexpr TensorTerms scatter_terms{.moment = true, .gradient = !Kernel::constant_inertia};
+  void scatter_form(const Source& s, ScatterForm<Dim>& form) const {
+    using F = ScatterForm<Dim>;
+    form.alpha[F::m] = s.m;
+    form.alpha.template segment<Dim>(F::p) = s.mv;
+    for (int a = 0; a < Dim; ++a) {
+      form.gamma[a].template segment<Dim>(F::p) = s.mC.col(a);
+      if constexpr (Kernel::constant_inertia) {
+        form.gamma[a].template segment<Dim>(F::f) = -this->moments_.D_inv() * s.tauV.col(a);
+      } else {
+        form.beta[a].template segment<Dim>(F::f) = -s.tauV.col(a);
+      }
+    }
+  }
+
   struct Gather {
     V v = V::Zero();
     M C = M::Zero();
   };
+  static constexpr TensorTerms gather_terms{.moment = Kernel::constant_inertia,
+                                            .gradient = !Kernel::constant_inertia};
+  Gather gather_from(const GatherSums<Dim>& sums) const {
+    return {sums.v, this->moments_.from_sums(sums.B, sums.G)};
+  }
   void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
     g.v += w * v_i;
     g.C += v_i * this->moments_.weight_moment(w, grad, d).transpose();

@@ -12,6 +12,7 @@
 
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
+#include "core/tensor_transfer.hpp"
 
 namespace mpmtb {
 
@@ -38,10 +39,23 @@ class PicPolicy {
     f_i -= s.tauV * grad;
   }
 
+  // The base solver's fast path (core/tensor_transfer.hpp): the same math as
+  // scatter() and gather(), as sums over the stencil.
+  using TensorPath = PicPolicy;
+  static constexpr TensorTerms scatter_terms{.gradient = true};
+  void scatter_form(const Source& s, ScatterForm<Dim>& form) const {
+    using F = ScatterForm<Dim>;
+    form.alpha[F::m] = s.m;
+    form.alpha.template segment<Dim>(F::p) = s.mv;
+    for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(F::f) = -s.tauV.col(a);
+  }
+
   struct Gather {
     V v = V::Zero();
     M grad_v = M::Zero();
   };
+  static constexpr TensorTerms gather_terms{.gradient = true};
+  Gather gather_from(const GatherSums<Dim>& sums) const { return {sums.v, sums.G}; }
   void gather(Gather& g, Real w, const V& grad, const V&, const V& v_i, const V&) const {
     g.v += w * v_i;
     g.grad_v += v_i * grad.transpose();

@@ -9,7 +9,8 @@
 namespace mpmtb {
 namespace {
 
-Scene block_scene(int dim, const std::string& transfer, const std::string& kernel) {
+Scene block_scene(int dim, const std::string& transfer, const std::string& kernel,
+                  const std::string& model) {
   const std::string text =
       "[scene]\nname = \"block\"\ndim = " + std::to_string(dim) +
       "\ndims = [2, 3]\n"
@@ -19,19 +20,22 @@ Scene block_scene(int dim, const std::string& transfer, const std::string& kerne
       transfer + "\"\nkernel = \"" + kernel +
       "\"\n"
       "[time]\nt_end = 1.0\ndt = 1e-4\n"
-      "[materials.m]\nmodel = \"neo-hookean\"\nE = 1e4\nnu = 0.3\ndensity = 1.0\n"
+      "[materials.m]\nmodel = \"" +
+      model + "\"\nE = 1e4\nnu = 0.3\ndensity = 1.0\n" +
+      (model == "damage" ? "sigma_crit = 1e3\n" : "") +
       "[[bodies]]\nshape = \"box\"\nmin = [0.25, 0.25, 0.25]\nmax = [0.75, 0.75, 0.75]\n"
       "material = \"m\"\nvelocity = [0.5, 0.2, 0.1]\nangular_velocity = [1.0, 2.0, 3.0]\n";
   toml::table tree = parse_scene_text(text, "bench");
   return read_scene(tree, "bench");
 }
 
-enum class Stage { step, p2g, grid, g2p };
+// p2g includes the stresses (the models' tau), constitutive the return maps.
+enum class Stage { step, p2g, grid, g2p, constitutive };
 
 template <int Dim>
 void run_stage(benchmark::State& bench, const std::string& transfer, const std::string& kernel,
-               Stage stage) {
-  const Scene scene = block_scene(Dim, transfer, kernel);
+               const std::string& model, Stage stage) {
+  const Scene scene = block_scene(Dim, transfer, kernel, model);
   State<Dim> s = build_state<Dim>(scene);
   Parameters params = scene.transfer_params;
   auto st = make_stepper<Dim>(transfer, kernel, params);
@@ -51,6 +55,9 @@ void run_stage(benchmark::State& bench, const std::string& transfer, const std::
       case Stage::g2p:
         benchmark::DoNotOptimize(st->grid_to_particles(s, dt));
         break;
+      case Stage::constitutive:
+        st->constitutive_update(s, dt);
+        break;
     }
   }
   const double n = static_cast<double>(s.particles.size());
@@ -62,28 +69,38 @@ void run_stage(benchmark::State& bench, const std::string& transfer, const std::
       n * bench.iterations() / 1e9, benchmark::Counter::kIsRate | benchmark::Counter::kInvert);
 }
 
-// Registers one benchmark per dimension x transfer x kernel x stage.
+// Registers one benchmark per dimension x transfer x kernel x stage (neo-Hookean),
+// and the pinned block's combination (3D, MLS-MPM, quadratic) with damage.
+void register_case(int dim, const std::string& transfer, const std::string& kernel,
+                   const std::string& model) {
+  const std::pair<const char*, Stage> stages[] = {{"step", Stage::step},
+                                                  {"p2g", Stage::p2g},
+                                                  {"grid", Stage::grid},
+                                                  {"g2p", Stage::g2p},
+                                                  {"constitutive", Stage::constitutive}};
+  for (const auto& [stage_name, stage] : stages) {
+    const std::string name = std::to_string(dim) + "d/" + transfer + "/" + kernel + "/" +
+                             (model == "neo-hookean" ? "" : model + "/") + stage_name;
+    benchmark::RegisterBenchmark(name.c_str(),
+                                 [=](benchmark::State& b) {
+                                   if (dim == 2) run_stage<2>(b, transfer, kernel, model, stage);
+                                   if (dim == 3) run_stage<3>(b, transfer, kernel, model, stage);
+                                 })
+        ->Unit(benchmark::kMillisecond)
+        ->UseRealTime();
+  }
+}
+
 const bool registered = [] {
-  const std::pair<const char*, Stage> stages[] = {
-      {"step", Stage::step}, {"p2g", Stage::p2g}, {"grid", Stage::grid}, {"g2p", Stage::g2p}};
   for (int dim : {2, 3}) {
     for (const auto& t : transfer_list()) {
       for (const auto& k : kernel_list()) {
         if (!unsupported_reason(t.name, k.name).empty()) continue;
-        for (const auto& [stage_name, stage] : stages) {
-          const std::string name =
-              std::to_string(dim) + "d/" + t.name + "/" + k.name + "/" + stage_name;
-          benchmark::RegisterBenchmark(name.c_str(),
-                                       [=](benchmark::State& b) {
-                                         if (dim == 2) run_stage<2>(b, t.name, k.name, stage);
-                                         if (dim == 3) run_stage<3>(b, t.name, k.name, stage);
-                                       })
-              ->Unit(benchmark::kMillisecond)
-              ->UseRealTime();
-        }
+        register_case(dim, t.name, k.name, "neo-hookean");
       }
     }
   }
+  register_case(3, "mls", "quadratic", "damage");
   return true;
 }();
 

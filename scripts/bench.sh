@@ -1,0 +1,96 @@
+#!/usr/bin/env bash
+# Throughput table: builds mpmtb in double (./build) and float (./build-float),
+# runs each bench case REPEATS times and writes the medians of particle-steps
+# per second to results/bench/throughput.csv (and prints the table).
+#   REPEATS=5 (default)  runs per case; the median is reported
+#   QUICK=1              only the pinned block and the 2D snow scene
+#   MPMTB_ARCH=x86-64-v3 passed to cmake for both builds (-march)
+# The machine is shared and noisy: compare ratios measured in the same run, and
+# read load_1min (the 1-minute load average when the case ran) beside each row.
+set -euo pipefail
+cd "$(dirname "$0")/.."
+REPEATS=${REPEATS:-5}
+arch=()
+[ -n "${MPMTB_ARCH:-}" ] && arch=(-DMPMTB_ARCH="$MPMTB_ARCH")
+if [ "${SKIP_BUILD:-0}" != 1 ]; then
+  cmake -S . -B build -DCMAKE_BUILD_TYPE=Release "${arch[@]}" >/dev/null
+  cmake --build build -j "$(nproc)" --target mpmtb >/dev/null
+  cmake -S . -B build-float -DCMAKE_BUILD_TYPE=Release -DMPMTB_REAL=float \
+    -DMPMTB_BUILD_TESTS=OFF "${arch[@]}" >/dev/null
+  cmake --build build-float -j "$(nproc)" --target mpmtb >/dev/null
+fi
+
+out=results/bench/throughput.csv
+tmp=$(mktemp -d)
+trap 'rm -rf "$tmp"' EXIT
+mkdir -p results/bench
+rows="$tmp/rows.csv"
+echo "dim,transfer,kernel,model,particles,threads,particle_steps_per_second,ns_per_particle_step,case,real,domain,runs,load_1min" >"$rows"
+
+field() {  # summary.json key -> value (numbers and plain strings)
+  sed -n "s/^  \"$2\": *\"\{0,1\}\([^\",]*\)\"\{0,1\},\{0,1\}$/\1/p" "$1" | head -n 1
+}
+
+# measure CASE REAL THREADS DOMAIN SCENE [mpmtb run options...]
+measure() {
+  local name=$1 real=$2 threads=$3 domain=$4 scene=$5
+  shift 5
+  local exe=build/cases/mpmtb
+  [ "$real" = float ] && exe=build-float/cases/mpmtb
+  local rates="$tmp/rates" run="$tmp/run"
+  : >"$rates"
+  for _ in $(seq "$REPEATS"); do
+    rm -rf "$run"
+    OMP_NUM_THREADS=$threads "$exe" run "$scene" --threads "$threads" "$@" --out "$run" >/dev/null 2>&1 ||
+      { echo "bench: case $name failed: $exe run $scene $*" >&2; exit 1; }
+    field "$run/summary.json" particle_steps_per_second >>"$rates"
+  done
+  local median
+  median=$(sort -g "$rates" | awk '{v[NR] = $1} END {print (NR % 2) ? v[(NR + 1) / 2] : (v[NR / 2] + v[NR / 2 + 1]) / 2}')
+  local model
+  model=$(tr -d '\n ' <"$run/summary.json" | sed -n 's/.*"models":\["\([^"]*\)".*/\1/p')
+  local load
+  load=$(cut -d ' ' -f 1 /proc/loadavg)
+  printf '%s,%s,%s,%s,%s,%s,%.0f,%.1f,%s,%s,%s,%s,%s\n' \
+    "$(field "$run/summary.json" dim)" "$(field "$run/summary.json" transfer)" \
+    "$(field "$run/summary.json" kernel)" "$model" "$(field "$run/summary.json" particles)" \
+    "$threads" "$median" "$(awk -v r="$median" 'BEGIN {print 1e9 / r}')" "$name" "$real" \
+    "$domain" "$REPEATS" "$load" >>"$rows"
+  tail -n 1 "$rows"
+}
+
+block=tests/bench/scenes/block.toml
+snow=tests/bench/scenes/snow88.toml
+pinned=(pinned_block --t-end 0.01)
+
+# The pinned block (32,768 particles, MLS-MPM, quadratic, damage): the targets.
+for real in double float; do
+  for threads in 1 2; do measure pinned_block "$real" "$threads" 1 "${pinned[@]}"; done
+done
+# The 88-line reference's 2D snow scene, one thread.
+for real in float double; do measure snow88 "$real" 1 1 "$snow" --t-end 0.02; done
+if [ "${QUICK:-0}" != 1 ]; then
+  # Scaling with the particle count: n^3 particles, n = 20, 32, 50, 80.
+  for n in 20 32 50 80; do
+    for threads in 1 2; do measure scaling double "$threads" 1 "$block" --cells "$n"; done
+  done
+  # The same block (same dx, 32,768 particles) in a domain 4x as long per axis.
+  for threads in 1 2; do
+    measure domain4x double "$threads" 4 "$block" --cells 128 --set grid.length=4 \
+      --set 'domain.max=[4,4,4]'
+  done
+  # Every transfer x kernel, 3D (32,768 particles) and 2D (128^2 = 16,384), 2 threads.
+  for dim in 3 2; do
+    cells=32
+    [ "$dim" = 2 ] && cells=128
+    for transfer in pic flip apic mls; do
+      for kernel in linear quadratic cubic; do
+        measure transfers double 2 1 "$block" --dim "$dim" --cells "$cells" \
+          --transfer "$transfer" --kernel "$kernel"
+      done
+    done
+  done
+fi
+cp "$rows" "$out.tmp" && mv "$out.tmp" "$out"
+echo "bench: wrote $out"
+column -s, -t "$out"
