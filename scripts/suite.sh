@@ -26,5 +26,6 @@ rm -rf results/pinned_block/3d
 # The suites (convergence, stability, speed-accuracy) at the quick level: every
 # transfer x kernel, one run per child process, resumable (results/suites).
 "$mpmtb" suite all --quick --out results/suites
+bash scripts/gallery.sh
 /usr/bin/python3 analysis/plot_all.py --results results
 echo "mpmtb: results in results/README.md"
