@@ -37,4 +37,14 @@ std::string CsvTable::render() const {
   return s;
 }
 
+std::string csv_field(const std::string& s) {
+  if (s.find_first_of(",\"\n") == std::string::npos) return s;
+  std::string q = "\"";
+  for (char c : s) {
+    q += c;
+    if (c == '"') q += c;
+  }
+  return q + '"';
+}
+
 }  // namespace mpmtb

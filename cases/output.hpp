@@ -17,4 +17,8 @@ struct CsvTable {
   std::string render() const;
 };
 
+// A text cell for a CSV table: quoted (with doubled quotes) when it holds a
+// comma, a quote or a newline (RFC 4180).
+std::string csv_field(const std::string& s);
+
 }  // namespace mpmtb

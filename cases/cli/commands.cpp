@@ -16,17 +16,6 @@
 namespace mpmtb {
 namespace {
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) {
-    q += c;
-    if (c == '"') q += c;
-  }
-  q += '"';
-  return q;
-}
-
 std::string number_field(const nlohmann::json& j, const char* key) {
   return j.contains(key) && j[key].is_number() ? fmt::format("{:.10g}", j[key].get<double>()) : "";
 }

@@ -65,16 +65,6 @@ bool runnable(const SuiteRequest& r, const std::string& name, const std::string&
 
 // ------------------------------------------------------------- tables --
 
-std::string csv_field(const std::string& s) {
-  if (s.find_first_of(",\"\n") == std::string::npos) return s;
-  std::string q = "\"";
-  for (char c : s) {
-    q += c;
-    if (c == '"') q += c;
-  }
-  return q + '"';
-}
-
 // A number for a table; NaN (missing, unstable) is an empty cell.
 std::string num(double v) {
   return std::isfinite(v) ? fmt::format("{:.6g}", v) : "";
