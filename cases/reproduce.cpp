@@ -40,8 +40,9 @@ toml::array json_to_toml_array(const nlohmann::json& a) {
 
 toml::table json_to_toml(const nlohmann::json& object) {
   toml::table out;
-  for (const auto& [k, v] : object.items()) {
-    insert_value(v, [&](auto&& x) { out.insert_or_assign(k, std::move(x)); });
+  for (const auto& item : object.items()) {
+    const std::string key = item.key();  // named: clang 14 cannot capture a structured binding
+    insert_value(item.value(), [&](auto&& x) { out.insert_or_assign(key, std::move(x)); });
   }
   return out;
 }
