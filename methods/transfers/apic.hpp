@@ -47,13 +47,8 @@ class ApicPolicy {
   using TensorPath = ApicPolicy;
   static constexpr TensorTerms scatter_terms{.moment = true, .gradient = true};
   void scatter_form(const Source& s, ScatterForm<Dim>& form) const {
-    using F = ScatterForm<Dim>;
-    form.alpha[F::m] = s.m;
-    form.alpha.template segment<Dim>(F::p) = s.mv;
-    for (int a = 0; a < Dim; ++a) {
-      form.gamma[a].template segment<Dim>(F::p) = s.mC.col(a);
-      form.beta[a].template segment<Dim>(F::f) = -s.tauV.col(a);
-    }
+    momentum_form(s, form);
+    for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(F_::f) = -s.tauV.col(a);
   }
 
   struct Gather {
@@ -78,6 +73,13 @@ class ApicPolicy {
   }
 
  protected:
+  using F_ = ScatterForm<Dim>;
+  // The same momentum as a linear form: alpha = (m_p, m_p v_p), gamma_a = m_p C_p e_a.
+  void momentum_form(const Source& s, ScatterForm<Dim>& form) const {
+    form.alpha[F_::m] = s.m;
+    form.alpha.template segment<Dim>(F_::p) = s.mv;
+    for (int a = 0; a < Dim; ++a) form.gamma[a].template segment<Dim>(F_::p) = s.mC.col(a);
+  }
   // m_i += w m_p, p_i += w m_p (v_p + C_p (x_i - x_p)): shared with MLS-MPM.
   void scatter_momentum(const Source& s, Real w, const V& d, Real& m_i, V& p_i) const {
     m_i += w * s.m;

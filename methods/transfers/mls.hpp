@@ -38,10 +38,8 @@ class MlsPolicy : public ApicPolicy<Dim, Kernel> {
   static constexpr TensorTerms scatter_terms{.moment = true, .gradient = !Kernel::constant_inertia};
   void scatter_form(const Source& s, ScatterForm<Dim>& form) const {
     using F = ScatterForm<Dim>;
-    form.alpha[F::m] = s.m;
-    form.alpha.template segment<Dim>(F::p) = s.mv;
+    this->momentum_form(s, form);
     for (int a = 0; a < Dim; ++a) {
-      form.gamma[a].template segment<Dim>(F::p) = s.mC.col(a);
       if constexpr (Kernel::constant_inertia) {
         form.gamma[a].template segment<Dim>(F::f) = -this->moments_.D_inv() * s.tauV.col(a);
       } else {

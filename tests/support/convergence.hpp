@@ -3,12 +3,14 @@
 #pragma once
 
 #include <fmt/format.h>
+#include <gtest/gtest.h>
 
 #include <cmath>
 #include <filesystem>
 #include <functional>
 #include <limits>
 #include <string>
+#include <tuple>
 #include <vector>
 
 #include "run.hpp"
@@ -57,6 +59,14 @@ inline std::string error_table(const std::vector<int>& levels, const std::vector
     s += "\n";
   }
   return s;
+}
+
+// The manufactured bar's large amplitude (REFERENCE.md: G = 0.05).
+inline const std::vector<std::string> kLarge = {"reference.amplitude=0.05"};
+
+using Combination = std::tuple<std::string, std::string>;  // transfer, kernel
+inline std::string combination_name(const ::testing::TestParamInfo<Combination>& info) {
+  return std::get<0>(info.param) + "_" + std::get<1>(info.param);
 }
 
 }  // namespace mpmtb::testing

@@ -31,13 +31,9 @@ using testing::error_table;
 using testing::errors_over;
 using testing::orders_of;
 
-const std::vector<std::string> kLarge = {"reference.amplitude=0.05"};
-
-using Combination = std::tuple<std::string, std::string>;  // transfer, kernel
-
-std::string combination_name(const ::testing::TestParamInfo<Combination>& info) {
-  return std::get<0>(info.param) + "_" + std::get<1>(info.param);
-}
+using testing::Combination;
+using testing::combination_name;
+using testing::kLarge;
 
 // ---- 1D bar, small amplitude G = 1e-4 --------------------------------------
 // Levels 8..64: at 8 cells the quadratic and cubic stencils (3 and 4 cells)
