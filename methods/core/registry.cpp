@@ -44,7 +44,10 @@ void require_known(std::string_view transfer, std::string_view kernel) {
 std::vector<VariantInfo> transfer_list() {
   std::vector<VariantInfo> out = infos<AllTransfers>();
   std::size_t i = 0;
-  AllTransfers::for_each([&]<class T>() { out[i++].affine = T::affine_momentum; });
+  AllTransfers::for_each([&]<class T>() {
+    out[i].affine = T::affine_momentum;
+    out[i++].conserves_angular_momentum = T::conserves_angular_momentum;
+  });
   return out;
 }
 std::vector<VariantInfo> kernel_list() {

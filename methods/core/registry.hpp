@@ -16,6 +16,7 @@ struct VariantInfo {
   std::string name;
   std::string description;
   bool affine = false;  // transfers: P2G carries C_p, so L includes the affine part
+  bool conserves_angular_momentum = false;  // transfers: claimed, and tested to round-off
 };
 
 std::vector<VariantInfo> transfer_list();

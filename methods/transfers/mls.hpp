@@ -74,6 +74,9 @@ struct MlsTransfer {
   static constexpr std::string_view description =
       "MLS-MPM: APIC with the MLS force and F from C (Hu et al. 2018); linear: gradient form";
   static constexpr bool affine_momentum = true;
+  // Claims angular momentum conservation, the affine part included, in both
+  // transfers (the conformance tests hold it to round-off).
+  static constexpr bool conserves_angular_momentum = true;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>
   static constexpr bool supports = true;

@@ -72,6 +72,9 @@ struct PicTransfer {
   static constexpr std::string_view description =
       "PIC: particle velocity replaced by the grid's (Sulsky et al. 1994); dissipative";
   static constexpr bool affine_momentum = false;
+  // Claims angular momentum conservation, the affine part included, in both
+  // transfers (the conformance tests hold it to round-off).
+  static constexpr bool conserves_angular_momentum = false;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>
   static constexpr bool supports = true;

@@ -19,13 +19,17 @@ inline void PrintTo(const Combination& c, std::ostream* os) {
   *os << c.dim << "D " << c.transfer << " " << c.kernel;
 }
 
-// affine_only: only the transfers that carry C_p in P2G (APIC-like).
+// Which transfers: all, or those that claim angular momentum conservation
+// (APIC-like: C_p in P2G and L to round-off both ways).
+enum class Transfers { all, conserving_angular_momentum };
+
 inline std::vector<Combination> all_combinations(std::vector<int> dims = {1, 2, 3},
-                                                 bool affine_only = false) {
+                                                 Transfers which = Transfers::all) {
   std::vector<Combination> out;
   for (int dim : dims) {
     for (const auto& t : transfer_list()) {
-      if (affine_only && !t.affine) continue;
+      if (which == Transfers::conserving_angular_momentum && !t.conserves_angular_momentum)
+        continue;
       for (const auto& k : kernel_list()) {
         if (unsupported_reason(t.name, k.name).empty()) out.push_back({dim, t.name, k.name});
       }

@@ -49,7 +49,7 @@ class TransferTest : public ::testing::TestWithParam<Combination> {
     return testing::free_body_toml(GetParam().dim, GetParam().transfer, GetParam().kernel);
   }
 };
-// The transfers with affine momentum (APIC-like), in 2D and 3D.
+// The transfers that claim angular momentum conservation (APIC-like), in 2D and 3D.
 class AffineTransferTest : public TransferTest {};
 
 // G2P hands back exactly the momentum the grid holds: sum_p m_p v_p = sum_i m_i v_i.
@@ -130,7 +130,8 @@ INSTANTIATE_TEST_SUITE_P(AllCombinations, TransferTest,
                          ::testing::ValuesIn(testing::all_combinations()),
                          testing::combination_name);
 INSTANTIATE_TEST_SUITE_P(AffineCombinations, AffineTransferTest,
-                         ::testing::ValuesIn(testing::all_combinations({2, 3}, true)),
+                         ::testing::ValuesIn(testing::all_combinations(
+                             {2, 3}, testing::Transfers::conserving_angular_momentum)),
                          testing::combination_name);
 
 std::string rotating(int dim) {
