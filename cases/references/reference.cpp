@@ -1,6 +1,7 @@
 #include "references/reference.hpp"
 
 #include "models/registry.hpp"
+#include "references/column.hpp"
 #include "references/manufactured.hpp"
 #include "references/vibrating_bar.hpp"
 #include "scene.hpp"
@@ -8,7 +9,7 @@
 namespace mpmtb {
 
 std::vector<std::string> reference_kinds() {
-  return {"vibrating-bar", "mms-bar", "mms-axis"};
+  return {"vibrating-bar", "mms-bar", "mms-axis", "column"};
 }
 
 template <int Dim>
@@ -23,6 +24,7 @@ std::unique_ptr<Reference<Dim>> make_reference(const Scene& scene) {
   if (scene.reference == "mms-bar" || scene.reference == "mms-axis") {
     return std::make_unique<ManufacturedReference<Dim>>(scene, scene.reference);
   }
+  if (scene.reference == "column") return std::make_unique<ColumnCollapse<Dim>>(scene);
   return nullptr;  // unreachable: read_scene accepts only reference_kinds()
 }
 

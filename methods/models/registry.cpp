@@ -9,6 +9,7 @@
 #include "models/fixed_corotated.hpp"
 #include "models/linear_elastic.hpp"
 #include "models/neo_hookean.hpp"
+#include "models/sand.hpp"
 #include "models/snow.hpp"
 
 namespace mpmtb {
@@ -38,6 +39,7 @@ const std::vector<ModelEntry>& entries() {
       entry<LinearElastic>("small-strain linear elastic, E nu density; not frame indifferent"),
       entry<FixedCorotated>("fixed-corotated, E nu density; invertible (Stomakhin et al. 2012)"),
       entry<Snow>("fixed-corotated snow plasticity, theta_c theta_s xi (Stomakhin et al. 2013)"),
+      entry<Sand>("Drucker-Prager sand on Hencky StVK, friction_angle h1 h2 h3 (Klar et al. 2016)"),
       entry<Damage>("isotropic damage, neo-Hookean tension split (CD-MPM 2019, AnisoMPM 2020)"),
   };
   return list;

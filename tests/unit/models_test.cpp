@@ -50,6 +50,15 @@ const std::vector<std::pair<std::string, Real>> kInvalidElastic = {
     {"nu", 0.7}, {"nu", -1}, {"density", 0},      {"density", -1}};
 const std::map<std::string, std::vector<std::pair<std::string, Real>>> kInvalid = {
     {"snow", {{"theta_c", 0}, {"theta_c", -0.1}, {"theta_c", 1}, {"theta_s", 0}, {"xi", -1}}},
+    {"sand",
+     {{"friction_angle", 0},
+      {"friction_angle", 90},
+      {"friction_angle", -5},
+      {"h1", -1},
+      {"h2", 0},
+      {"h3", 30},
+      {"h3", -1},
+      {"h1", 1000}}},
     {"damage", {{"sigma_crit", 0}, {"zeta", 0}, {"eta", 0}, {"k", 1}, {"k", -0.1}}}};
 
 std::map<std::string, Real> ValidParams(const std::string& model) {
@@ -125,7 +134,10 @@ TEST_P(ModelConformance, StressIsEnergyGradient) {
       for (std::size_t p = 0; p < Fs.size(); ++p) {
         const Mat<Dim> F = P.F[p], Pk = m.first_piola(F, P.state_of(p));
         const Mat<Dim> P_fd = FiniteDifferenceP(m, F, P.state_of(p));
-        EXPECT_LT((Pk - P_fd).norm(), 1e-6 * Pk.norm()) << "pass " << pass << " F =\n" << F;
+        // The floor 1e-9 E covers the O(h^2) truncation error where P = 0 (a
+        // plastic state projected to a stress-free one, e.g. sand's cone tip).
+        EXPECT_LT((Pk - P_fd).norm(), 1e-6 * Pk.norm() + 1e-9 * kE) << "pass " << pass << " F =\n"
+                                                                    << F;
       }
       for (auto& F : P.F) F = F * RandomF<Dim>(gen_, 0.2);
       m.return_map(P, Ids(P.size()), 1e-3);
