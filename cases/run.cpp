@@ -171,6 +171,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   State<Dim> s = build_state<Dim>(scene);
   Parameters transfer_params = scene.transfer_params;
   auto stepper = make_stepper<Dim>(scene.transfer, scene.kernel, transfer_params);
+  stepper->set_update_order(scene.update_order);
   auto reference = make_reference<Dim>(scene);
   if (reference) reference->initialize(s);
 

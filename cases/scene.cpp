@@ -62,6 +62,15 @@ void read_method(TableReader& top, Scene& s) {
   TableReader m(top.table("method"), "method");
   s.transfer = m.choice("transfer", names_of(transfer_list()));
   s.kernel = m.choice("kernel", names_of(kernel_list()));
+  if (m.has("update_order")) {
+    const std::vector<std::string> orders(kUpdateOrderNames.begin(), kUpdateOrderNames.end());
+    const std::string order = m.choice("update_order", orders);
+    s.update_order =
+        static_cast<UpdateOrder>(std::find(orders.begin(), orders.end(), order) - orders.begin());
+  } else if (auto* method = s.resolved["method"].as_table()) {
+    // Recorded in summaries like the other method keys, default included.
+    method->insert("update_order", std::string(update_order_name(s.update_order)));
+  }
   m.finish();
   // A table named after a transfer holds that transfer's parameters ([flip] alpha = ...).
   // Tables of the other transfers are kept for switching with --transfer, but
@@ -334,6 +343,7 @@ void apply_overrides(toml::table& tree, const Overrides& o) {
   if (o.ppc) set("grid.ppc", *o.ppc);
   if (o.transfer) set_string("method.transfer", *o.transfer);
   if (o.kernel) set_string("method.kernel", *o.kernel);
+  if (o.update_order) set_string("method.update_order", *o.update_order);
   if (o.t_end) set("time.t_end", fmt::format("{:.17g}", *o.t_end));
   if (o.cfl || o.dt) {
     if (auto* t = tree["time"].as_table()) {

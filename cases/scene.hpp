@@ -13,6 +13,7 @@
 
 #include "boundary/colliders.hpp"
 #include "core/parameters.hpp"
+#include "core/stepper.hpp"
 #include "core/types.hpp"
 
 namespace mpmtb {
@@ -51,6 +52,7 @@ struct Scene {
   int ppc = 2;      // particles per cell per axis
   std::string transfer, kernel;
   Parameters transfer_params;
+  UpdateOrder update_order = UpdateOrder::usl;  // stress-update order (core/stepper.hpp)
   Real t_end = 1;
   std::optional<Real> dt, cfl;  // exactly one is set
   Real output_interval = 0.1;
@@ -76,6 +78,7 @@ struct Overrides {
   std::optional<int> ppc = {};
   std::optional<std::string> transfer = {};
   std::optional<std::string> kernel = {};
+  std::optional<std::string> update_order = {};
   std::optional<std::string> model = {};
   std::optional<Real> cfl = {};
   std::optional<Real> dt = {};

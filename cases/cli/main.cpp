@@ -40,6 +40,10 @@ void add_override_options(CLI::App& cmd, mpmtb::Overrides& o) {
       "--kernel", o.kernel,
       fmt::format("kernel: {}, or `all` for a sweep (default: the scene's [method] kernel)",
                   names(mpmtb::kernel_list())));
+  cmd.add_option("--update-order", o.update_order,
+                 fmt::format("stress-update order: {} (default: the scene's [method] "
+                             "update_order, or usl)",
+                             fmt::join(mpmtb::kUpdateOrderNames, ", ")));
   cmd.add_option("--model", o.model,
                  fmt::format("constitutive model for every material: {} (default: each "
                              "material's own)",

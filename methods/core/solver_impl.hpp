@@ -30,6 +30,7 @@ class Solver final : public Stepper<Dim> {
 
   std::string_view transfer_name() const override { return Transfer::name; }
   std::string_view kernel_name() const override { return Kernel::name; }
+  bool gradient_based() const override { return transfer_is_gradient_based<Transfer>(); }
 
   void particles_to_grid(State<Dim>& s, Real dt) override {
     (void)dt;  // forces are kept apart from momentum; the grid update integrates them
@@ -37,21 +38,7 @@ class Solver final : public Stepper<Dim> {
     clear_active_box(s.grid);
     bin_particles_into_blocks(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
-    // Blocks of Kernel::support cells along the first two axes: the stencils of
-    // blocks two apart never overlap, so the blocks of one colour (the parity of
-    // their block coordinates) scatter in parallel, one colour after the other.
-    // No locks, and the summation order (and so the result) does not depend on
-    // the thread count.
-    const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
-    const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
-    for (int colour = 0; colour < kColours; ++colour) {
-#pragma omp parallel for schedule(dynamic, 1) if (parallel)
-      for (int b = colour * per_colour; b < (colour + 1) * per_colour; ++b) {
-        for (int k = block_start_[b]; k < block_start_[b + 1]; ++k) {
-          scatter_particle(s, policy, block_order_[k]);
-        }
-      }
-    }
+    for_each_particle_coloured(s, [&](int p) { scatter_particle<true>(s, policy, p); });
   }
 
   void update_grid(State<Dim>& s, Real dt) override {
@@ -94,6 +81,15 @@ class Solver final : public Stepper<Dim> {
   }
 
   StepReport grid_to_particles(State<Dim>& s, Real dt) override {
+    return gather_particles<true>(s, dt);
+  }
+  StepReport move_particles(State<Dim>& s, Real dt) override {
+    return gather_particles<false>(s, dt);
+  }
+
+  // G2P; kDeform = false keeps F (the motion part of usf and musl).
+  template <bool kDeform>
+  StepReport gather_particles(State<Dim>& s, Real dt) {
     Particles<Dim>& P = s.particles;
     const Grid<Dim>& g = s.grid;
     const Policy policy(transfer_params_, g.geo.dx);
@@ -116,7 +112,13 @@ class Solver final : public Stepper<Dim> {
           policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
         });
       }
-      policy.finish(gather, P, static_cast<int>(p), dt);
+      if constexpr (kDeform) {
+        policy.finish(gather, P, static_cast<int>(p), dt);
+      } else {
+        const Mat<Dim> F = P.F[p];
+        policy.finish(gather, P, static_cast<int>(p), dt);
+        P.F[p] = F;
+      }
       // Failure detection, fused into this loop so that it costs nothing extra.
       const Real J = P.F[p].determinant();
       J_min = std::min(J_min, J);
@@ -154,6 +156,87 @@ class Solver final : public Stepper<Dim> {
       }
     }
     return L;
+  }
+
+  // The split stages of the other update orders (core/stepper.hpp).
+  // P2G momentum part: the transfer's own P2G with zero stress and no body force.
+  void scatter_momentum(State<Dim>& s) override {
+    tauV_.assign(s.particles.size(), Mat<Dim>::Zero());
+    clear_active_box(s.grid);
+    bin_particles_into_blocks(s);
+    const Policy policy(transfer_params_, s.grid.geo.dx);
+    for_each_particle_coloured(s, [&](int p) { scatter_particle<false>(s, policy, p); });
+  }
+  // Force, on the blocks scatter_momentum binned (the particles have not moved).
+  void scatter_forces(State<Dim>& s) override {
+    compute_stresses(s);
+    for_each_particle_coloured(s, [&](int p) { scatter_force(s, p); });
+  }
+
+  // v_i = p_i / m_i with walls, pinned nodes and colliders, for the F update.
+  // Folding the walls' ghosts changes m and p, which the grid update that may
+  // follow (usf) folds again, so they are kept and restored; no impulse is
+  // exchanged with the boundaries here, so none is recorded.
+  void grid_velocities(State<Dim>& s, Real t) override {
+    Grid<Dim>& g = s.grid;
+    const long rows = g.active_rows();
+    m_kept_.resize(g.m.size());
+    p_kept_.resize(g.p.size());
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      std::copy_n(g.m.begin() + first, count, m_kept_.begin() + first);
+      std::copy_n(g.p.begin() + first, count, p_kept_.begin() + first);
+    }
+    s.walls.fold(g);
+#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      for (long i = first; i < first + count; ++i) {
+        if (g.m[i] > 0 && !g.pinned[i]) {
+          g.v[i] = g.p[i] / g.m[i];
+        } else {
+          g.v[i].setZero();
+        }
+      }
+    }
+    s.walls.apply(g);
+    if (!s.colliders.empty()) {
+      Vec3 impulse = Vec3::Zero();
+      Real work = 0;
+      s.colliders.apply(g, t, impulse, work);
+    }
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      std::copy_n(m_kept_.begin() + first, count, g.m.begin() + first);
+      std::copy_n(p_kept_.begin() + first, count, g.p.begin() + first);
+    }
+  }
+
+  // F_p <- (I + dt sum_i v_i grad w_ip^T) F_p, the F update of every
+  // gradient-based transfer (Sulsky et al. 1994), from the grid's v.
+  StepReport update_deformation(State<Dim>& s, Real dt) override {
+    Particles<Dim>& P = s.particles;
+    const Grid<Dim>& g = s.grid;
+    const long n = static_cast<long>(P.size());
+    Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min;
+    long non_finite = n;
+#pragma omp parallel for schedule(static) reduction(min                  \
+                                                    : J_min, non_finite) \
+    reduction(max                                                        \
+              : J_max) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      const StencilT st(P.x[p], g.geo);
+      const Mat<Dim> G =
+          TensorTransfer<Dim, Kernel>::template gather<TensorTerms{.gradient = true}>(
+              st, g.geo, g.v.data(), g.v_old.data())
+              .G;
+      P.F[p] = (Mat<Dim>::Identity() + dt * G) * P.F[p];
+      const Real J = P.F[p].determinant();
+      J_min = std::min(J_min, J);
+      J_max = std::max(J_max, J);
+      if (!std::isfinite(J)) non_finite = std::min(non_finite, p);
+    }
+    return {J_min, J_max, 0, non_finite == n ? -1 : non_finite, -1};
   }
 
  private:
@@ -241,6 +324,25 @@ class Solver final : public Stepper<Dim> {
     for (long p = 0; p < n; ++p) block_order_[fill_[block_of_[p]]++] = static_cast<int>(p);
   }
 
+  // Blocks of Kernel::support cells along the first two axes: the stencils of
+  // blocks two apart never overlap, so the blocks of one colour (the parity of
+  // their block coordinates) scatter in parallel, one colour after the other.
+  // No locks, and the summation order (and so the result) does not depend on
+  // the thread count.
+  template <class Scatter>
+  void for_each_particle_coloured(const State<Dim>& s, Scatter&& scatter) {
+    const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
+    const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
+    for (int colour = 0; colour < kColours; ++colour) {
+#pragma omp parallel for schedule(dynamic, 1) if (parallel)
+      for (int b = colour * per_colour; b < (colour + 1) * per_colour; ++b) {
+        for (int k = block_start_[b]; k < block_start_[b + 1]; ++k) scatter(block_order_[k]);
+      }
+    }
+  }
+
+  // kBodyForce = false: the momentum part only (tauV_ is zero then).
+  template <bool kBodyForce>
   void scatter_particle(State<Dim>& s, const Policy& policy, int p) {
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
@@ -252,13 +354,13 @@ class Solver final : public Stepper<Dim> {
     if constexpr (kTensorPath) {
       ScatterForm<Dim> form;
       policy.scatter_form(src, form);
-      if (s.body_force) {
+      if (kBodyForce && s.body_force) {
         form.alpha.template segment<Dim>(ScatterForm<Dim>::f) +=
             P.m[p] * s.body_force(P, p, s.time);
       }
       TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(st, g.geo, form, m, mom,
                                                                            f);
-    } else if (!s.body_force) {
+    } else if (!kBodyForce || !s.body_force) {
       st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
         policy.scatter(src, w, grad, d, m[node], mom[node], f[node]);
       });
@@ -276,7 +378,23 @@ class Solver final : public Stepper<Dim> {
     }
   }
 
+  // f_i += -V0_p tau_p grad w_ip + w_ip m_p b_p: the force of a gradient-based
+  // transfer (Sulsky et al. 1994), the force part of the split P2G.
+  void scatter_force(State<Dim>& s, int p) {
+    const Particles<Dim>& P = s.particles;
+    Grid<Dim>& g = s.grid;
+    using Form = ScatterForm<Dim>;
+    Form form;
+    for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(Form::f) = -tauV_[p].col(a);
+    if (s.body_force)
+      form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
+    TensorTransfer<Dim, Kernel>::template scatter<TensorTerms{.gradient = true}>(
+        StencilT(P.x[p], g.geo), g.geo, form, g.m.data(), g.p.data(), g.f.data());
+  }
+
   Parameters transfer_params_;
+  std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
+  std::vector<Vec<Dim>> p_kept_;
   std::vector<Mat<Dim>> tauV_;  // V0_p tau_p, from the materials
   // P2G colouring: blocks over the first two axes (one in 1D), 2^axes colours.
   static constexpr int kColouredAxes = Dim >= 2 ? 2 : 1;

@@ -78,6 +78,9 @@ struct MlsTransfer {
   // transfers (the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = true;
   static constexpr bool needs_old_velocity = false;
+  // F is updated from C_p and the MLS force is fused with the affine momentum,
+  // so P2G and G2P cannot be split: only update_order = "usl" (core/stepper.hpp).
+  static constexpr bool gradient_based = false;
   template <class Kernel>
   static constexpr bool supports = true;
   static constexpr std::string_view unsupported_reason = "";
