@@ -21,12 +21,31 @@ struct Particles {
   // Per-model internal state (plastic J, damage, ...): state_size values per particle.
   int state_size = 0;
   std::vector<Real> state;
+  // Per-transfer state (e.g. PolyPIC's higher velocity modes): transfer_state_size
+  // values per particle, sized by the solver for its transfer, zero at the start.
+  int transfer_state_size = 0;
+  std::vector<Real> transfer_state;
 
   std::size_t size() const { return x.size(); }
 
   Real* state_of(std::size_t p) { return state_size ? &state[p * state_size] : nullptr; }
   const Real* state_of(std::size_t p) const {
     return state_size ? &state[p * state_size] : nullptr;
+  }
+
+  Real* transfer_state_of(std::size_t p) {
+    return transfer_state_size ? &transfer_state[p * transfer_state_size] : nullptr;
+  }
+  const Real* transfer_state_of(std::size_t p) const {
+    return transfer_state_size ? &transfer_state[p * transfer_state_size] : nullptr;
+  }
+  // The solver's transfer needs n values per particle: a different size starts
+  // from zeros (a transfer's state means nothing to another one).
+  void use_transfer_state(int n) {
+    if (n != transfer_state_size) {
+      transfer_state_size = n;
+      transfer_state.assign(size() * n, Real(0));
+    }
   }
 
   // Appends one particle at rest with F = I, C = 0.
@@ -41,6 +60,7 @@ struct Particles {
     material.push_back(mat);
     pinned.push_back(pin ? 1 : 0);
     state.resize(state.size() + state_size, Real(0));
+    transfer_state.resize(transfer_state.size() + transfer_state_size, Real(0));
   }
 };
 

@@ -24,6 +24,14 @@ class Solver final : public Stepper<Dim> {
   // The policy's transfers as sums over the stencil (core/tensor_transfer.hpp),
   // or, for a policy that does not declare them, its per-node math.
   static constexpr bool kTensorPath = has_tensor_path<Policy>();
+  // Per-particle values the transfer keeps between steps (Particles::transfer_state).
+  static constexpr int kTransferState = [] {
+    if constexpr (requires { Policy::transfer_state_size; }) {
+      return Policy::transfer_state_size;
+    } else {
+      return 0;
+    }
+  }();
 
  public:
   Solver(Parameters& transfer_params) : transfer_params_(transfer_params) {}
@@ -35,6 +43,7 @@ class Solver final : public Stepper<Dim> {
   void particles_to_grid(State<Dim>& s, Real dt) override {
     (void)dt;  // forces are kept apart from momentum; the grid update integrates them
     compute_stresses(s);
+    s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
     bin_particles_into_blocks(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
@@ -93,6 +102,7 @@ class Solver final : public Stepper<Dim> {
     Particles<Dim>& P = s.particles;
     const Grid<Dim>& g = s.grid;
     const Policy policy(transfer_params_, g.geo.dx);
+    P.use_transfer_state(kTransferState);
     const long n = static_cast<long>(P.size());
     Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min, v_max = 0;
     long non_finite = n, outside = n;
@@ -102,7 +112,7 @@ class Solver final : public Stepper<Dim> {
               : J_max, v_max) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       const StencilT st(P.x[p], g.geo);
-      typename Policy::Gather gather;
+      typename Policy::Gather gather = begin_gather(policy, st);
       if constexpr (kTensorPath) {
         gather =
             policy.gather_from(TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(
@@ -162,6 +172,7 @@ class Solver final : public Stepper<Dim> {
   // P2G momentum part: the transfer's own P2G with zero stress and no body force.
   void scatter_momentum(State<Dim>& s) override {
     tauV_.assign(s.particles.size(), Mat<Dim>::Zero());
+    s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
     bin_particles_into_blocks(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
@@ -347,7 +358,7 @@ class Solver final : public Stepper<Dim> {
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
     const StencilT st(P.x[p], g.geo);
-    const auto src = policy.prepare(P, p, tauV_[p]);
+    const auto src = prepare(policy, P, p, st);
     Real* m = g.m.data();
     Vec<Dim>* mom = g.p.data();
     Vec<Dim>* f = g.f.data();
@@ -390,6 +401,23 @@ class Solver final : public Stepper<Dim> {
       form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
     TensorTransfer<Dim, Kernel>::template scatter<TensorTerms{.gradient = true}>(
         StencilT(P.x[p], g.geo), g.geo, form, g.m.data(), g.p.data(), g.f.data());
+  }
+
+  // A policy whose per-particle data depends on the stencil (its 1D weights) is
+  // handed the stencil when it prepares a particle's P2G and starts its G2P.
+  auto prepare(const Policy& policy, const Particles<Dim>& P, int p, const StencilT& st) const {
+    if constexpr (requires { policy.prepare(P, p, tauV_[p], st); }) {
+      return policy.prepare(P, p, tauV_[p], st);
+    } else {
+      return policy.prepare(P, p, tauV_[p]);
+    }
+  }
+  static typename Policy::Gather begin_gather(const Policy& policy, const StencilT& st) {
+    if constexpr (requires { policy.begin_gather(st); }) {
+      return policy.begin_gather(st);
+    } else {
+      return {};
+    }
   }
 
   Parameters transfer_params_;

@@ -8,9 +8,12 @@
 #include "transfers/flip.hpp"
 #include "transfers/mls.hpp"
 #include "transfers/pic.hpp"
+#include "transfers/polypic.hpp"
+#include "transfers/tpic.hpp"
 
 namespace mpmtb {
 
-using AllTransfers = TypeList<PicTransfer, FlipTransfer, ApicTransfer, MlsTransfer>;
+using AllTransfers =
+    TypeList<PicTransfer, FlipTransfer, ApicTransfer, MlsTransfer, TpicTransfer, PolypicTransfer>;
 
 }  // namespace mpmtb

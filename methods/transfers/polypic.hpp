@@ -1,0 +1,259 @@
+// PolyPIC: Fu, Guo, Gast, Jiang & Teran 2017, "A Polynomial Particle-In-Cell
+// Method", ACM TOG 36(6) 222.
+// Each particle carries a polynomial velocity field over its stencil,
+//   v_p(x_i) = sum_r c_p^r s_r(x_i - x_p),
+// in modes s_r that are orthogonal on the stencil's nodes under the weights w_ip
+// (sec. 4-5). The modes are tensor products of 1D polynomials e_0 = 1, e_1, ...,
+// e_{S-1} (S = Kernel::support), built per particle and axis by Gram-Schmidt
+// under the 1D weights, so all S^Dim modes of the stencil are kept.
+//   P2G momentum  m_p w_ip sum_r c_r s_r(i)
+//   force, F      as APIC (kernel gradient)
+//   G2P           c_r = sum_i w_ip s_r(i) v_i / sum_i w_ip s_r(i)^2   (a weighted projection)
+// The constant mode is v_p (= PIC's), the linear modes are APIC's C_p = B_p D_p^-1;
+// they stay in P.v and P.C, the higher modes go to Particles::transfer_state
+// (normalized: see finish()). With the modes orthonormal at each position, G2P
+// (Bessel's inequality) and P2G (Jensen's) cannot create kinetic energy.
+// Every higher mode is orthogonal to 1 and to x_i - x_p, so it carries no linear
+// or angular momentum: both are conserved as in APIC (the conformance tests hold
+// it to round-off).
+#pragma once
+
+#include <cmath>
+#include <limits>
+#include <string_view>
+
+#include "core/parameters.hpp"
+#include "core/particles.hpp"
+#include "core/stencil.hpp"
+
+namespace mpmtb {
+
+// The 1D polynomials e_n of one particle along each axis, orthogonal under the
+// kernel weights: sum_k w_a(k) e_n(u_k) e_m(u_k) = 0 for n != m, with
+// u_k = (x_i - x_p)_a / dx the node offsets in cell units. The tensor products
+// s_r(i) = prod_a e_{r_a}(u_{i_a}) are then orthogonal under w_ip = prod_a w_a,
+// and their norms factor: sum_i w_ip s_r(i)^2 = prod_a norm[a][r_a].
+template <int Dim, int S>
+struct PolyModes {
+  static constexpr int count = ipow(S, Dim);  // modes = stencil nodes
+
+  Real e[Dim][S][S];  // e[a][n][k]: e_n at node k of axis a
+  Real norm[Dim][S];  // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
+  Real d0[Dim];       // offset of node 0 per axis
+  Real inv_dx;
+
+  // Gram-Schmidt of the monomials 1, u, u^2, ... under the weights, twice over
+  // ("twice is enough"): orthogonal to round-off relative to each e_n's own size,
+  // so the higher modes add no momentum beyond round-off. A mode whose norm falls
+  // below a relative tolerance of its monomial's is degenerate (fewer weighted
+  // nodes than modes, e.g. the linear hat at a node, or the quadratic B-spline
+  // half-way between nodes): it and every higher one are dropped.
+  template <class Kernel>
+  void build(const Stencil<Dim, Kernel>& st, Real dx) {
+    static_assert(Kernel::support == S);
+    inv_dx = 1 / dx;
+    const Real tol = 1000 * std::numeric_limits<Real>::epsilon();
+    for (int a = 0; a < Dim; ++a) {
+      d0[a] = st.d[a][0];
+      Real u[S], power[S];
+      for (int k = 0; k < S; ++k) u[k] = st.d[a][k] * inv_dx, power[k] = 1;
+      bool dropped = false;
+      for (int n = 0; n < S; ++n) {
+        Real* q = e[a][n];
+        Real monomial = 0;
+        for (int k = 0; k < S; ++k) {
+          q[k] = power[k];
+          monomial += st.w[a][k] * q[k] * q[k];
+          power[k] *= u[k];
+        }
+        for (int pass = 0; pass < 2; ++pass) {
+          for (int m = 0; m < n; ++m) {
+            if (norm[a][m] == 0) continue;
+            Real dot = 0;
+            for (int k = 0; k < S; ++k) dot += st.w[a][k] * q[k] * e[a][m][k];
+            const Real c = dot / norm[a][m];
+            for (int k = 0; k < S; ++k) q[k] -= c * e[a][m][k];
+          }
+        }
+        Real nn = 0;
+        for (int k = 0; k < S; ++k) nn += st.w[a][k] * q[k] * q[k];
+        dropped = dropped || !(nn > tol * monomial);
+        norm[a][n] = dropped ? Real(0) : nn;
+      }
+    }
+  }
+
+  // The stencil index (last axis fastest, as Stencil::for_each_node) of the node
+  // at offset d = x_i - x_p.
+  int node_index(const Vec<Dim>& d) const {
+    int index = 0;
+    for (int a = 0; a < Dim; ++a) {
+      index = index * S + static_cast<int>(std::lround((d[a] - d0[a]) * inv_dx));
+    }
+    return index;
+  }
+
+  // sum_i w_ip s_r(i)^2, or 0 when the mode is dropped.
+  Real mode_norm(int r) const {
+    Real n = 1;
+    for (int a = Dim - 1; a >= 0; --a, r /= S) n *= norm[a][r % S];
+    return n;
+  }
+
+  // out[j] = sum_k T_a[j_a][k] in[j with j_a -> k] along one axis, with T_a = e[a]
+  // (nodal values -> mode sums) or its transpose (mode coefficients -> nodal values).
+  template <bool Transpose>
+  void apply_axis(int a, const Vec<Dim>* in, Vec<Dim>* out) const {
+    const int stride = ipow(S, Dim - 1 - a);
+    for (int j = 0; j < count; ++j) {
+      const int ja = (j / stride) % S, base = j - ja * stride;
+      Vec<Dim> acc = Vec<Dim>::Zero();
+      for (int k = 0; k < S; ++k)
+        acc += (Transpose ? e[a][k][ja] : e[a][ja][k]) * in[base + k * stride];
+      out[j] = acc;
+    }
+  }
+  // Sum factorization: the S^Dim x S^Dim transform as Dim passes of S x S.
+  template <bool Transpose>
+  void transform(Vec<Dim>* values) const {
+    Vec<Dim> tmp[count];
+    for (int a = 0; a < Dim; ++a) {
+      apply_axis<Transpose>(a, values, tmp);
+      for (int j = 0; j < count; ++j) values[j] = tmp[j];
+    }
+  }
+
+  // Mode r = (r_0, ..., r_{Dim-1}) as a flat index: 0 is the constant, linear(a)
+  // the mode e_1 along axis a; the rest are the higher modes.
+  static constexpr int linear(int a) { return ipow(S, Dim - 1 - a); }
+  static constexpr bool higher(int r) {
+    if (r == 0) return false;
+    for (int a = 0; a < Dim; ++a)
+      if (r == linear(a)) return false;
+    return true;
+  }
+};
+
+template <int Dim, class Kernel>
+class PolypicPolicy {
+  using V = Vec<Dim>;
+  using M = Mat<Dim>;
+  static constexpr int S = Kernel::support;
+  using Modes = PolyModes<Dim, S>;
+  static constexpr int kModes = Modes::count;
+
+ public:
+  // The higher-mode coefficients per particle: Dim values per mode.
+  static constexpr int transfer_state_size = (kModes - 1 - Dim) * Dim;
+
+  PolypicPolicy(Parameters&, Real dx) : dx_(dx) {}
+
+  struct Source {
+    Real m;
+    M tauV;
+    Modes modes;
+    V mv[kModes];  // m_p v_p(x_i) at each stencil node
+  };
+  // Rebuilds the modes at the particle's current stencil (the orthogonality that
+  // conservation needs is under these weights) and evaluates its field at the nodes.
+  Source prepare(const Particles<Dim>& P, int p, const M& tauV,
+                 const Stencil<Dim, Kernel>& st) const {
+    Source s;
+    s.m = P.m[p];
+    s.tauV = tauV;
+    s.modes.build(st, dx_);
+    V* c = s.mv;
+    const Real* stored = P.transfer_state_of(p);
+    for (int r = 0; r < kModes; ++r) {
+      if (Modes::higher(r)) {
+        c[r] = Eigen::Map<const V>(stored);
+        stored += Dim;
+      }
+    }
+    c[0] = P.v[p];
+    // Linear modes in cell units: e_1 = (x_i - x_p)_a / dx, so c = C_p e_a dx.
+    for (int a = 0; a < Dim; ++a) c[Modes::linear(a)] = P.C[p].col(a) * dx_;
+    for (int r = 1; r < kModes; ++r) {
+      const Real n = s.modes.mode_norm(r);
+      if (n == 0) {
+        c[r].setZero();
+      } else if (Modes::higher(r)) {
+        c[r] /= std::sqrt(n);  // stored for the orthonormal mode (see finish)
+      }
+    }
+    s.modes.template transform<true>(c);  // coefficients -> nodal velocities
+    for (int j = 0; j < kModes; ++j) c[j] *= s.m;
+    return s;
+  }
+  void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
+               V& f_i) const {
+    m_i += w * s.m;
+    p_i += w * s.mv[s.modes.node_index(d)];
+    f_i -= s.tauV * grad;
+  }
+
+  struct Gather {
+    Modes modes;
+    V v = V::Zero();
+    M grad_v = M::Zero();
+    V wv[kModes];  // w_ip v_i at each stencil node
+  };
+  Gather begin_gather(const Stencil<Dim, Kernel>& st) const {
+    Gather g;
+    g.modes.build(st, dx_);
+    for (auto& x : g.wv) x.setZero();
+    return g;
+  }
+  void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
+    g.wv[g.modes.node_index(d)] = w * v_i;
+    g.v += w * v_i;
+    g.grad_v += v_i * grad.transpose();
+  }
+  void finish(Gather& g, Particles<Dim>& P, int p, Real dt) const {
+    V* c = g.wv;
+    g.modes.template transform<false>(c);  // sum_i w_ip s_r(i) v_i per mode
+    for (int r = 1; r < kModes; ++r) {
+      const Real n = g.modes.mode_norm(r);
+      c[r] = n > 0 ? V(c[r] / n) : V::Zero();
+    }
+    Real* stored = P.transfer_state_of(p);
+    for (int r = 0; r < kModes; ++r) {
+      if (Modes::higher(r)) {
+        // Stored as the coefficient of the orthonormal mode s_r / |s_r|: a particle's
+        // stencil energy sum_r |c_r|^2 |s_r|^2 then survives the rebuild of its modes
+        // at the moved position in P2G. Storing c_r itself let a nearly degenerate
+        // mode (tiny |s_r|, large c_r) gain norm one step later and inject energy
+        // (the disks gained 2.1x).
+        Eigen::Map<V>{stored} = c[r] * std::sqrt(g.modes.mode_norm(r));
+        stored += Dim;
+      }
+    }
+    // The constant mode is sum_i w_ip v_i (sum_i w_ip = 1): PIC's velocity.
+    P.v[p] = g.v;
+    for (int a = 0; a < Dim; ++a) P.C[p].col(a) = c[Modes::linear(a)] / dx_;
+    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    P.x[p] += dt * g.v;
+  }
+
+ private:
+  Real dx_;
+};
+
+struct PolypicTransfer {
+  static constexpr std::string_view name = "polypic";
+  static constexpr std::string_view description =
+      "PolyPIC: per-particle polynomial velocity in all S^Dim stencil modes, orthogonal "
+      "under the weights (Fu et al. 2017); kernel-gradient force and F";
+  // P.C holds the linear modes (APIC's C_p), so the diagnostics count the affine
+  // angular momentum; the higher modes carry none.
+  static constexpr bool affine_momentum = true;
+  static constexpr bool conserves_angular_momentum = true;
+  static constexpr bool needs_old_velocity = false;
+  template <class Kernel>
+  static constexpr bool supports = true;
+  static constexpr std::string_view unsupported_reason = "";
+  template <int Dim, class Kernel>
+  using Policy = PolypicPolicy<Dim, Kernel>;
+};
+
+}  // namespace mpmtb

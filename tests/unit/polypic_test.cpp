@@ -1,0 +1,187 @@
+// PolyPIC (Fu, Guo, Gast, Jiang & Teran 2017): its per-particle modes, the
+// exactness of the round trip for fields in their span, and the energy it keeps.
+// Conservation of mass, momentum and angular momentum: the conformance tests
+// (transfer_test.cpp), which it joins through the registry.
+#include <gtest/gtest.h>
+
+#include <fstream>
+#include <sstream>
+
+#include "core/diagnostics.hpp"
+#include "kernels/all.hpp"
+#include "run.hpp"
+#include "setup.hpp"
+#include "support/combinations.hpp"
+#include "support/scenes.hpp"
+#include "transfers/polypic.hpp"
+
+namespace mpmtb {
+namespace {
+
+// The 1D modes of a stencil: e_0 = 1, e_1 = u (B-splines have zero first
+// moment), orthogonal under the weights; the norms are the weighted sums.
+template <class Kernel>
+void check_modes(Real x, Real dx) {
+  const GridGeometry<1> geo(Vec<1>::Zero(), dx, {8});
+  const Stencil<1, Kernel> st(Vec<1>(x), geo);
+  PolyModes<1, Kernel::support> modes;
+  modes.build(st, dx);
+  constexpr int S = Kernel::support;
+  for (int k = 0; k < S; ++k) {
+    EXPECT_EQ(modes.e[0][0][k], 1);
+    EXPECT_NEAR(modes.e[0][1][k], st.d[0][k] / dx, 1e-14);
+  }
+  for (int n = 0; n < S; ++n) {
+    if (modes.norm[0][n] == 0) continue;
+    Real nn = 0;
+    for (int k = 0; k < S; ++k) nn += st.w[0][k] * modes.e[0][n][k] * modes.e[0][n][k];
+    EXPECT_NEAR(modes.norm[0][n], nn, 1e-14);
+    for (int m = 0; m < n; ++m) {
+      Real dot = 0;
+      for (int k = 0; k < S; ++k) dot += st.w[0][k] * modes.e[0][n][k] * modes.e[0][m][k];
+      EXPECT_LE(std::abs(dot), 1e-15) << Kernel::name << " modes " << n << ", " << m;
+    }
+  }
+}
+
+TEST(PolypicModes, OrthogonalUnderTheWeights) {
+  for (const Real x : {2.3, 2.61, 3.05, 4.999}) {
+    check_modes<LinearKernel>(x * 0.1, 0.1);
+    check_modes<QuadraticKernel>(x * 0.1, 0.1);
+    check_modes<CubicKernel>(x * 0.1, 0.1);
+  }
+}
+
+// Fewer weighted nodes than modes: the hat at a node has one (the linear mode
+// vanishes there), the quadratic B-spline half-way between nodes two (the
+// quadratic mode is constant on them). Those modes are dropped, not divided by 0.
+TEST(PolypicModes, DegenerateModesAreDropped) {
+  const GridGeometry<1> geo(Vec<1>::Zero(), 0.25, {8});
+  const Stencil<1, LinearKernel> hat(Vec<1>(0.75), geo);
+  PolyModes<1, 2> m2;
+  m2.build(hat, 0.25);
+  EXPECT_GT(m2.norm[0][0], 0);
+  EXPECT_EQ(m2.norm[0][1], 0);
+  const Stencil<1, QuadraticKernel> quad(Vec<1>(0.625), geo);
+  PolyModes<1, 3> m3;
+  m3.build(quad, 0.25);
+  EXPECT_GT(m3.norm[0][1], 0);
+  EXPECT_EQ(m3.norm[0][2], 0);
+}
+
+// A velocity field of degree <= support - 1 along every axis (here: affine,
+// quadratic and the full tensor product x_0^2 x_1^2 ...) lies, on each stencil,
+// in the span of the particle's modes. G2P from the nodal values v(x_i) sets the
+// coefficients (a projection, exact for such a field); P2G then rebuilds
+// v_i = sum_p m_p w_ip v_p(x_i) / m_i = v(x_i) at every node with mass, and a
+// second G2P returns the same coefficients. Returns the nodal error; the
+// coefficient drift goes to `drift`.
+template <int Dim>
+Real polynomial_round_trip(const std::string& transfer, const std::string& kernel, Real& drift) {
+  const Scene scene = testing::scene_from_toml(testing::free_body_toml(Dim, transfer, kernel), {});
+  State<Dim> s = build_state<Dim>(scene);
+  Parameters params = scene.transfer_params;
+  auto st = make_stepper<Dim>(transfer, kernel, params);
+  auto field = [](const Vec<Dim>& x) {
+    Vec<Dim> v;
+    Real tensor = 0.8;
+    for (int a = 0; a < Dim; ++a) tensor *= x[a] * x[a];
+    for (int i = 0; i < Dim; ++i) {
+      v[i] = 0.3 - 0.1 * i + tensor * (1 - i);
+      for (int j = 0; j < Dim; ++j)
+        v[i] += (0.7 * (i + 1) - 0.4 * j) * x[j] + 0.5 * (j + 1 - i) * x[j] * x[j];
+    }
+    return v;
+  };
+  Grid<Dim>& g = s.grid;
+  auto& P = s.particles;
+  st->particles_to_grid(s, 0);
+  st->update_grid(s, 0);
+  for (long i = 0; i < g.geo.node_count(); ++i) g.v[i] = field(g.geo.position(i));
+  st->grid_to_particles(s, 0);
+  const auto v1 = P.v;
+  const auto C1 = P.C;
+  const auto q1 = P.transfer_state;
+  st->particles_to_grid(s, 0);
+  st->update_grid(s, 0);
+  Real err = 0, scale = 0;
+  for (long i = 0; i < g.geo.node_count(); ++i) {
+    if (g.m[i] <= 0) continue;
+    const Vec<Dim> exact = field(g.geo.position(i));
+    err = std::max(err, (g.v[i] - exact).norm());
+    scale = std::max(scale, exact.norm());
+  }
+  st->grid_to_particles(s, 0);
+  drift = 0;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    drift = std::max(drift, (P.v[p] - v1[p]).norm() / v1[p].norm());
+    drift = std::max(drift, (P.C[p] - C1[p]).norm() / C1[p].norm());
+  }
+  Real qmax = 0, qdiff = 0;
+  for (std::size_t k = 0; k < q1.size(); ++k) {
+    qmax = std::max(qmax, std::abs(q1[k]));
+    qdiff = std::max(qdiff, std::abs(P.transfer_state[k] - q1[k]));
+  }
+  if (qmax > 0) drift = std::max(drift, qdiff / qmax);
+  return err / scale;
+}
+
+TEST(Polypic, PolynomialFieldRoundTripIsExact) {
+  for (const char* kernel : {"quadratic", "cubic"}) {
+    for (int dim : {1, 2, 3}) {
+      testing::with_dim(dim, [&]<int Dim>() {
+        Real drift = 0;
+        EXPECT_LE(polynomial_round_trip<Dim>("polypic", kernel, drift), 1e-12)
+            << Dim << "D " << kernel;
+        EXPECT_LE(drift, 1e-11) << Dim << "D " << kernel;
+        // APIC keeps only the affine part: the test field is beyond it.
+        EXPECT_GT(polynomial_round_trip<Dim>("apic", kernel, drift), 1e-4) << Dim << "D";
+      });
+    }
+  }
+}
+
+// Energy kept, (kinetic + strain) at the end over the start, on the colliding
+// disks (Sulsky et al. 1994). PolyPIC's P2G/G2P round trip loses less than
+// APIC's (the modes beyond the affine ones survive), so it keeps at least as
+// much. The scene's full 3.5 s (3500 steps of 416 particles: about 3 s for
+// PolyPIC in Release on one core).
+Real energy_kept(const std::string& transfer) {
+  const Scene scene = load_scene("disks", {.transfer = transfer});
+  const auto dir = std::filesystem::temp_directory_path() / ("mpmtb_polypic_disks_" + transfer);
+  RunOptions options;
+  options.threads = 1;
+  const RunOutcome r = run_scene(scene, dir, options);
+  EXPECT_EQ(r.status, "ok") << r.reason;
+  std::ifstream in(dir / "series.csv");
+  std::string header, line, first, last;
+  std::getline(in, header);
+  std::getline(in, first);
+  while (std::getline(in, line)) last = line;
+  auto split = [](const std::string& row) {
+    std::vector<std::string> cells;
+    std::stringstream ss(row);
+    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
+    return cells;
+  };
+  const auto names = split(header);
+  auto energy = [&](const std::string& row) {
+    const auto cells = split(row);
+    Real e = 0;
+    for (std::size_t i = 0; i < names.size(); ++i)
+      if (names[i] == "kinetic" || names[i] == "strain") e += std::stod(cells[i]);
+    return e;
+  };
+  return energy(last) / energy(first);
+}
+
+TEST(Polypic, KeepsAtLeastApicsEnergyOnTheDisks) {
+  const Real apic = energy_kept("apic"), polypic = energy_kept("polypic");
+  EXPECT_GE(polypic, apic);
+  EXPECT_LE(polypic, 1.0 + 1e-3) << "no energy gain";
+  RecordProperty("apic", std::to_string(apic));
+  RecordProperty("polypic", std::to_string(polypic));
+}
+
+}  // namespace
+}  // namespace mpmtb
