@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "core/nonlocal.hpp"
+#include "core/policy_hooks.hpp"
 #include "core/solver.hpp"
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
@@ -112,6 +113,7 @@ class Solver final : public Stepper<Dim> {
             policy.gather_from(TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(
                 st, g.geo, g.v.data(), g.v_old.data()));
       } else {
+        gather = begin_gather(policy, st);  // core/policy_hooks.hpp
         st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
           policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
         });
@@ -245,7 +247,7 @@ class Solver final : public Stepper<Dim> {
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
     const StencilT st(P.x[p], g.geo);
-    const auto src = policy.prepare(P, p, tauV_[p]);
+    const auto src = prepare_source(policy, P, p, tauV_[p], st);  // core/policy_hooks.hpp
     Real* m = g.m.data();
     Vec<Dim>* mom = g.p.data();
     Vec<Dim>* f = g.f.data();
