@@ -100,8 +100,20 @@ TEST(GimpKernel, SmallHalfWidthTendsToTheHat) {
   }
 }
 
-// D_p per axis lies between l^2/3 dx^2 (the domain's own moment: never singular, unlike
-// the hat) and (1/4 + l^2/3) dx^2, and the stencil uses the grid's l.
+// uGIMP's D_p per axis in cell units from its definition as the hat averaged over the
+// particle domain [xi - l, xi + l]: the average of the hat's f (1 - f) plus l^2 / 3
+// (the domain's own second moment). H integrates f (1 - f) from 0 (1/6 per cell).
+Real GimpInertia(Real xi, Real l) {
+  auto H = [](Real x) {
+    const Real n = std::floor(x), t = x - n;
+    return n / 6 + t * t / 2 - t * t * t / 3;
+  };
+  return (H(xi + l) - H(xi - l)) / (2 * l) + l * l / 3;
+}
+
+// The stencil uses the grid's l: D_p equals the closed form above at that l. And D_p
+// per axis lies between l^2/3 dx^2 (the domain's own moment: never singular, unlike
+// the hat) and (1/4 + l^2/3) dx^2.
 TEST(GimpKernel, InertiaIsBoundedAwayFromZeroAndFollowsTheGridHalfWidth) {
   for (const Real l : kHalfWidths) {
     GridGeometry<2> g(Vec<2>(-0.3, 0.2), 0.37, {8, 8});
@@ -116,6 +128,7 @@ TEST(GimpKernel, InertiaIsBoundedAwayFromZeroAndFollowsTheGridHalfWidth) {
       st.for_each_node(g, [&](long, Real w, const Vec<2>&, const Vec<2>&) { wsum += w; });
       EXPECT_NEAR(wsum, 1, 1e-13);
       for (int a = 0; a < 2; ++a) {
+        EXPECT_NEAR(D[a], GimpInertia((xp[a] - g.lo[a]) / g.dx, l), 1e-12) << "l=" << l;
         EXPECT_GE(D[a], l * l / 3 - 1e-13) << "l=" << l;
         EXPECT_LE(D[a], Real(0.25) + l * l / 3 + 1e-13) << "l=" << l;
       }
