@@ -84,7 +84,9 @@ GridGeometry<Dim> scene_grid(const Scene& scene) {
     const Real extent = scene.domain_max[a] - scene.domain_min[a];
     cells[a] = std::max(1, static_cast<int>(std::ceil(extent / dx - 1e-9)));
   }
-  return GridGeometry<Dim>(head<Dim>(scene.domain_min), dx, cells);
+  GridGeometry<Dim> geo(head<Dim>(scene.domain_min), dx, cells);
+  geo.l = Real(1) / (2 * scene.ppc);  // particle half-width in cells (uGIMP)
+  return geo;
 }
 
 template <int Dim>

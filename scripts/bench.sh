@@ -84,7 +84,7 @@ if [ "${QUICK:-0}" != 1 ]; then
     cells=32
     [ "$dim" = 2 ] && cells=128
     for transfer in pic flip apic mls; do
-      for kernel in linear quadratic cubic; do
+      for kernel in linear quadratic cubic gimp; do
         measure transfers double 2 1 "$block" --dim "$dim" --cells "$cells" \
           --transfer "$transfer" --kernel "$kernel"
       done

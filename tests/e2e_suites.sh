@@ -22,9 +22,16 @@ import cmath, csv, math, sys
 root = sys.argv[1]
 
 
-def weight(kernel, r):
-    """N(r) and dN/dx_p for the kernels of shared/REFERENCE.md (dx = 1)."""
+def weight(kernel, r, l):
+    """N(r) and dN/dx_p for the kernels of shared/REFERENCE.md (dx = 1); l is uGIMP's
+    particle half-width 1/(2 ppc) (Bardenhagen & Kober 2004, eq. 40)."""
     a, s = abs(r), math.copysign(1.0, r)
+    if kernel == "gimp":
+        if a < l:
+            return 1 - (r * r + l * l) / (2 * l), -r / l
+        if a < 1 - l:
+            return 1 - a, -s
+        return ((1 + l - a) ** 2 / (4 * l), -s * (1 + l - a) / (2 * l)) if a < 1 + l else (0.0, 0.0)
     if kernel == "linear":
         return (1 - a, -s) if a < 1 else (0.0, 0.0)
     if kernel == "quadratic":
@@ -49,13 +56,14 @@ def pic_limit(kernel, ppc):
     lossless grid scheme's omega dt <= 2).
     """
     xs = [(j + 0.5) / ppc for j in range(ppc)]
+    l = 0.5 / ppc
     best = math.inf
     for n in range(1, 721):
         theta = math.pi * n / 720
         K = P = 0.0
         for x in xs:
-            g = sum(cmath.exp(1j * theta * i) * weight(kernel, x - i)[1] for i in range(-3, 5))
-            q = sum(cmath.exp(1j * theta * i) * weight(kernel, x - i)[0] for i in range(-3, 5))
+            g = sum(cmath.exp(1j * theta * i) * weight(kernel, x - i, l)[1] for i in range(-3, 5))
+            q = sum(cmath.exp(1j * theta * i) * weight(kernel, x - i, l)[0] for i in range(-3, 5))
             K += abs(g) ** 2 / ppc
             P += abs(q) ** 2 / ppc
         best = min(best, math.sqrt(2 * (1 + P) / K))
@@ -95,7 +103,7 @@ for s in stable:
                 and float(r["cfl"]) >= 1.25 * high:
             assert r["status"] == "unstable" and r["reason"] and r["fail_step"], r
     checked += 1
-assert checked == 2 * 3 * 2, f"checked {checked} method x ppc combinations"
+assert checked == 2 * 4 * 2, f"checked {checked} method x ppc combinations"
 print(f"stability: {checked} limits within +-25 % of the von Neumann estimate, "
       "PIC's on its derived limit")
 PY

@@ -88,11 +88,18 @@ template <int Dim>
 void Walls<Dim>::apply(Grid<Dim>& grid) const {
   constexpr int pad = GridGeometry<Dim>::pad;
   for_each_face_node(*this, grid.geo, [&](Wall w, int axis, int outward, long face, long out) {
-    if (grid.m[face] > 0) apply_wall<Dim>(w, axis, outward, grid.v[face]);
+    // Also on face nodes without mass: at a corner they are another face's ghosts,
+    // mirrored before this face's condition was applied to their mirrors.
+    apply_wall<Dim>(w, axis, outward, grid.v[face]);
     const int mirrored = w == Wall::separate ? 0 : mirrored_layers(grid.geo, axis);
     for (int k = 1; k <= pad; ++k) {
       const long ghost = face + k * out, mirror = face - k * out;
-      if (grid.m[ghost] <= 0) continue;
+      // Mirrored ghosts are set even where no particle reaches them: with a kernel
+      // whose support is narrower than its stencil (uGIMP: 1 + l cells over 3 nodes)
+      // they still enter the interpolation at points on the face, and corner ghosts
+      // then follow from the faces' passes in turn. Particles never read them
+      // (w_ip = 0 wherever m_i = 0), so particle results do not change.
+      if (grid.m[ghost] <= 0 && k > mirrored) continue;
       if (k <= mirrored) {
         grid.v[ghost] = reflected<Dim>(w, axis, grid.v[mirror]);
       } else {

@@ -20,6 +20,10 @@ struct GridGeometry {
   Vec<Dim> lo = Vec<Dim>::Zero();
   Real dx = 1;
   std::array<int, Dim> cells{};
+  // Particle half-width in cell units, l = 1/(2 ppc), for kernels that average over
+  // the particle domain (uGIMP, kernels/gimp.hpp); set from the scene's ppc. The
+  // default is two particles per cell per axis.
+  Real l = Real(0.25);
 
   GridGeometry() = default;
   GridGeometry(const Vec<Dim>& lower, Real spacing, const std::array<int, Dim>& n)

@@ -10,6 +10,7 @@
 #include <limits>
 
 #include "core/nonlocal.hpp"
+#include "core/policy_hooks.hpp"
 #include "core/solver.hpp"
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
@@ -112,12 +113,13 @@ class Solver final : public Stepper<Dim> {
               : J_max, v_max) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       const StencilT st(P.x[p], g.geo);
-      typename Policy::Gather gather = begin_gather(policy, st);
+      typename Policy::Gather gather;
       if constexpr (kTensorPath) {
         gather =
             policy.gather_from(TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(
                 st, g.geo, g.v.data(), g.v_old.data()));
       } else {
+        gather = begin_gather(policy, st);  // core/policy_hooks.hpp
         st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
           policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
         });
@@ -358,7 +360,7 @@ class Solver final : public Stepper<Dim> {
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
     const StencilT st(P.x[p], g.geo);
-    const auto src = prepare(policy, P, p, st);
+    const auto src = prepare_source(policy, P, p, tauV_[p], st);  // core/policy_hooks.hpp
     Real* m = g.m.data();
     Vec<Dim>* mom = g.p.data();
     Vec<Dim>* f = g.f.data();
@@ -401,23 +403,6 @@ class Solver final : public Stepper<Dim> {
       form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
     TensorTransfer<Dim, Kernel>::template scatter<TensorTerms{.gradient = true}>(
         StencilT(P.x[p], g.geo), g.geo, form, g.m.data(), g.p.data(), g.f.data());
-  }
-
-  // A policy whose per-particle data depends on the stencil (its 1D weights) is
-  // handed the stencil when it prepares a particle's P2G and starts its G2P.
-  auto prepare(const Policy& policy, const Particles<Dim>& P, int p, const StencilT& st) const {
-    if constexpr (requires { policy.prepare(P, p, tauV_[p], st); }) {
-      return policy.prepare(P, p, tauV_[p], st);
-    } else {
-      return policy.prepare(P, p, tauV_[p]);
-    }
-  }
-  static typename Policy::Gather begin_gather(const Policy& policy, const StencilT& st) {
-    if constexpr (requires { policy.begin_gather(st); }) {
-      return policy.begin_gather(st);
-    } else {
-      return {};
-    }
   }
 
   Parameters transfer_params_;

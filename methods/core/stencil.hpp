@@ -26,6 +26,24 @@ constexpr auto stencil_multi_indices() {
 }
 }  // namespace detail
 
+// Kernels whose weights depend on the particle half-width GridGeometry::l (uGIMP)
+// declare weights(r0, w, dw, l); the others keep their own code.
+template <class Kernel>
+constexpr bool kernel_uses_half_width = requires(Real* out) {
+  Kernel::weights(Real(1), out, out, Real(1));
+};
+
+// Kernels whose D_p = sum w (x_i - x_p)(x_i - x_p)^T is neither constant (B-splines)
+// nor singular (the hat): the affine transfers take the particle's own D_p.
+template <class Kernel>
+constexpr bool kernel_particle_inertia = [] {
+  if constexpr (requires { Kernel::particle_inertia; }) {
+    return Kernel::particle_inertia;
+  } else {
+    return false;
+  }
+}();
+
 template <int Dim, class Kernel>
 struct Stencil {
   static constexpr int S = Kernel::support;
@@ -48,7 +66,15 @@ struct Stencil {
       // First node of the support: floor(xi) for support 2, floor(xi - 1/2) for 3, floor(xi) - 1
       // for 4.
       const int first = first_index(xi);
-      if constexpr (requires(Real * out) { Kernel::weights(Real(1), out, out); }) {
+      if constexpr (kernel_uses_half_width<Kernel>) {
+        // The same with the particle half-width (uGIMP).
+        const Real r0 = xi - first;
+        Kernel::weights(r0, w[a], dw[a], g.l);
+        for (int k = 0; k < S; ++k) {
+          dw[a][k] *= inv_dx;
+          d[a][k] = -(r0 - k) * g.dx;
+        }
+      } else if constexpr (requires(Real * out) { Kernel::weights(Real(1), out, out); }) {
         // The kernel's own branch-free form for the whole support (same values).
         const Real r0 = xi - first;
         Kernel::weights(r0, w[a], dw[a]);

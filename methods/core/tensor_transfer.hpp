@@ -46,13 +46,15 @@ struct ScatterForm {
 };
 
 // G2P sums over the stencil: v = sum w v_i, B = sum w v_i (x_i - x_p)^T,
-// G = sum v_i grad w^T, v_old = sum w v_i_old.
+// G = sum v_i grad w^T, v_old = sum w v_i_old; and, for kernels whose D_p differs
+// per particle (uGIMP), D_inv = D_p^-1 from the stencil (diagonal).
 template <int Dim>
 struct GatherSums {
   Vec<Dim> v = Vec<Dim>::Zero();
   Mat<Dim> B = Mat<Dim>::Zero();
   Mat<Dim> G = Mat<Dim>::Zero();
   Vec<Dim> v_old = Vec<Dim>::Zero();
+  Vec<Dim> D_inv = Vec<Dim>::Zero();
 };
 
 // True when Policy itself (not only a base class) opts in to the fast path.
@@ -97,6 +99,7 @@ class TensorTransfer {
       if constexpr (T.moment) out.B.col(a) = part.Dm[a];
       if constexpr (T.gradient) out.G.col(a) = part.Gr[a];
     }
+    if constexpr (kernel_particle_inertia<Kernel>) out.D_inv = st.inertia_diagonal().cwiseInverse();
     return out;
   }
 

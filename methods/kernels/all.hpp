@@ -4,11 +4,12 @@
 
 #include "core/type_list.hpp"
 #include "kernels/cubic.hpp"
+#include "kernels/gimp.hpp"
 #include "kernels/linear.hpp"
 #include "kernels/quadratic.hpp"
 
 namespace mpmtb {
 
-using AllKernels = TypeList<LinearKernel, QuadraticKernel, CubicKernel>;
+using AllKernels = TypeList<LinearKernel, QuadraticKernel, CubicKernel, GimpKernel>;
 
 }  // namespace mpmtb

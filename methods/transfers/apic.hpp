@@ -32,9 +32,17 @@ class ApicPolicy {
     V mv;
     M mC;
     M tauV;
+    V D_inv = V::Zero();  // D_p^-1, for kernels whose D_p differs per particle (uGIMP)
   };
   Source prepare(const Particles<Dim>& P, int p, const M& tauV) const {
     return {P.m[p], P.m[p] * P.v[p], P.m[p] * P.C[p], tauV};
+  }
+  // The base solver calls this form when it exists: it adds the particle's D_p^-1.
+  Source prepare(const Particles<Dim>& P, int p, const M& tauV,
+                 const Stencil<Dim, Kernel>& st) const {
+    Source s = prepare(P, p, tauV);
+    if constexpr (AffineMoments<Dim, Kernel>::per_particle) s.D_inv = moments_.particle_D_inv(st);
+    return s;
   }
   void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
                V& f_i) const {
@@ -55,14 +63,23 @@ class ApicPolicy {
     V v = V::Zero();
     M C = M::Zero();
     M grad_v = M::Zero();
+    V D_inv = V::Zero();  // D_p^-1 for per-particle D_p (set by begin_gather)
   };
-  static constexpr TensorTerms gather_terms{.moment = Kernel::constant_inertia, .gradient = true};
+  static constexpr TensorTerms gather_terms{
+      .moment = Kernel::constant_inertia || AffineMoments<Dim, Kernel>::per_particle,
+      .gradient = true};
   Gather gather_from(const GatherSums<Dim>& sums) const {
-    return {sums.v, moments_.from_sums(sums.B, sums.G), sums.G};
+    return {sums.v, moments_.from_sums(sums.B, sums.G, sums.D_inv), sums.G};
+  }
+  // The per-node path starts from this (the base solver calls it when it exists).
+  Gather begin_gather(const Stencil<Dim, Kernel>& st) const {
+    Gather g;
+    if constexpr (AffineMoments<Dim, Kernel>::per_particle) g.D_inv = moments_.particle_D_inv(st);
+    return g;
   }
   void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
     g.v += w * v_i;
-    g.C += v_i * moments_.weight_moment(w, grad, d).transpose();
+    g.C += v_i * moments_.weight_moment(w, grad, d, g.D_inv).transpose();
     g.grad_v += v_i * grad.transpose();
   }
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
@@ -92,7 +109,7 @@ struct ApicTransfer {
   static constexpr std::string_view name = "apic";
   static constexpr std::string_view description =
       "APIC: affine momentum C_p, kernel-gradient force and F (Jiang et al. 2015); "
-      "linear: C_p = sum v_i grad w^T";
+      "linear: C_p = sum v_i grad w^T; gimp: the particle's own D_p";
   static constexpr bool affine_momentum = true;
   // Claims angular momentum conservation, the affine part included, in both
   // transfers (the conformance tests hold it to round-off).

@@ -29,19 +29,24 @@ class MlsPolicy : public ApicPolicy<Dim, Kernel> {
   void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
                V& f_i) const {
     this->scatter_momentum(s, w, d, m_i, p_i);
-    f_i -= s.tauV * this->moments_.weight_moment(w, grad, d);
+    f_i -= s.tauV * this->moments_.weight_moment(w, grad, d, s.D_inv);
   }
 
   // The base solver's fast path (core/tensor_transfer.hpp): the same math as
   // scatter() and gather(), as sums over the stencil.
   using TensorPath = MlsPolicy;
-  static constexpr TensorTerms scatter_terms{.moment = true, .gradient = !Kernel::constant_inertia};
+  // Kernels with a hat-like D_p use the gradient form (affine.hpp).
+  static constexpr bool kGradientForm =
+      !Kernel::constant_inertia && !AffineMoments<Dim, Kernel>::per_particle;
+  static constexpr TensorTerms scatter_terms{.moment = true, .gradient = kGradientForm};
   void scatter_form(const Source& s, ScatterForm<Dim>& form) const {
     using F = ScatterForm<Dim>;
     this->momentum_form(s, form);
     for (int a = 0; a < Dim; ++a) {
       if constexpr (Kernel::constant_inertia) {
         form.gamma[a].template segment<Dim>(F::f) = -this->moments_.D_inv() * s.tauV.col(a);
+      } else if constexpr (AffineMoments<Dim, Kernel>::per_particle) {
+        form.gamma[a].template segment<Dim>(F::f) = -s.D_inv[a] * s.tauV.col(a);
       } else {
         form.beta[a].template segment<Dim>(F::f) = -s.tauV.col(a);
       }
@@ -51,15 +56,22 @@ class MlsPolicy : public ApicPolicy<Dim, Kernel> {
   struct Gather {
     V v = V::Zero();
     M C = M::Zero();
+    V D_inv = V::Zero();  // D_p^-1 for per-particle D_p (set by begin_gather)
   };
-  static constexpr TensorTerms gather_terms{.moment = Kernel::constant_inertia,
-                                            .gradient = !Kernel::constant_inertia};
+  static constexpr TensorTerms gather_terms{.moment = !kGradientForm, .gradient = kGradientForm};
   Gather gather_from(const GatherSums<Dim>& sums) const {
-    return {sums.v, this->moments_.from_sums(sums.B, sums.G)};
+    return {sums.v, this->moments_.from_sums(sums.B, sums.G, sums.D_inv)};
+  }
+  Gather begin_gather(const Stencil<Dim, Kernel>& st) const {
+    Gather g;
+    if constexpr (AffineMoments<Dim, Kernel>::per_particle) {
+      g.D_inv = AffineMoments<Dim, Kernel>::particle_D_inv(st);
+    }
+    return g;
   }
   void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
     g.v += w * v_i;
-    g.C += v_i * this->moments_.weight_moment(w, grad, d).transpose();
+    g.C += v_i * this->moments_.weight_moment(w, grad, d, g.D_inv).transpose();
   }
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
     P.v[p] = g.v;
@@ -72,7 +84,8 @@ class MlsPolicy : public ApicPolicy<Dim, Kernel> {
 struct MlsTransfer {
   static constexpr std::string_view name = "mls";
   static constexpr std::string_view description =
-      "MLS-MPM: APIC with the MLS force and F from C (Hu et al. 2018); linear: gradient form";
+      "MLS-MPM: APIC with the MLS force and F from C (Hu et al. 2018); linear: gradient form; "
+      "gimp: the particle's own D_p";
   static constexpr bool affine_momentum = true;
   // Claims angular momentum conservation, the affine part included, in both
   // transfers (the conformance tests hold it to round-off).

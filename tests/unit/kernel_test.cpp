@@ -141,14 +141,36 @@ TYPED_TEST(KernelTest, GradientsAreConsistent) {
   CheckGradients<3, TypeParam>();
 }
 
-// Breakpoints of all three kernels sit at multiples of 1/2.
+// Breakpoints of the B-splines and the hat sit at multiples of 1/2, those of uGIMP at
+// l, 1 - l and 1 + l: multiples of 1/4 with the default half-width l = 1/4.
 bool NearBreakpoint(Real r, Real margin) {
-  return std::abs(2 * r - std::round(2 * r)) < 2 * margin;
+  return std::abs(4 * r - std::round(4 * r)) < 4 * margin;
+}
+
+// Radius of the kernel's support in cells: support / 2, or 1 + l for uGIMP (default l).
+template <class K>
+Real SupportRadius() {
+  if constexpr (std::is_same_v<K, GimpKernel>) {
+    return 1 + K::default_half_width;
+  } else {
+    return K::support / Real(2);
+  }
+}
+
+// uGIMP's D_p per axis in cell units, from its definition as the hat averaged over the
+// particle domain [xi - l, xi + l]: the average of the hat's f (1 - f) plus l^2 / 3
+// (the domain's own second moment). H integrates f (1 - f) from 0 (1/6 per cell).
+Real GimpInertia(Real xi, Real l) {
+  auto H = [](Real x) {
+    const Real n = std::floor(x), t = x - n;
+    return n / 6 + t * t / 2 - t * t * t / 3;
+  };
+  return (H(xi + l) - H(xi - l)) / (2 * l) + l * l / 3;
 }
 
 TYPED_TEST(KernelTest, ShapeIsNonNegativeAndDerivativeMatchesFiniteDifference) {
   using K = TypeParam;
-  const Real h = 1e-6, half = K::support / Real(2);
+  const Real h = 1e-6, half = SupportRadius<K>();
   for (Real r = -half - 0.25; r <= half + 0.25; r += 0.001237) {
     EXPECT_GE(K::N(r), 0) << "r = " << r;
     if (NearBreakpoint(r, 1e-4)) continue;
@@ -195,7 +217,8 @@ TYPED_TEST(KernelTest, StencilGradientMatchesFiniteDifference) {
   CheckStencilGradientByDifferences<3, TypeParam>();
 }
 
-// D_p = sum w (x_i - x_p)(x_i - x_p)^T: constant for B-splines, f (1 - f) dx^2 for the hat.
+// D_p = sum w (x_i - x_p)(x_i - x_p)^T: constant for B-splines, f (1 - f) dx^2 for the hat,
+// GimpInertia for uGIMP.
 template <int Dim, class K>
 void CheckInertia() {
   SCOPED_TRACE(::testing::Message() << K::name << ", Dim = " << Dim);
@@ -211,6 +234,8 @@ void CheckInertia() {
     } else if constexpr (std::is_same_v<K, LinearKernel>) {
       const Vec<Dim> f = CellFraction(xp, g);
       expected = (f.array() * (1 - f.array())).matrix() * dx2;
+    } else if constexpr (std::is_same_v<K, GimpKernel>) {
+      for (int a = 0; a < Dim; ++a) expected[a] = GimpInertia((xp[a] - g.lo[a]) / g.dx, g.l) * dx2;
     } else {
       FAIL() << "no expected D_p for a kernel without constant inertia";
     }
@@ -226,7 +251,7 @@ TYPED_TEST(KernelTest, InertiaDiagonalMatchesKernel) {
 
 TYPED_TEST(KernelTest, VanishesOutsideSupport) {
   using K = TypeParam;
-  const Real half = K::support / Real(2);
+  const Real half = SupportRadius<K>();
   // dN exactly at |r| = support/2 is a one-sided convention; only N must vanish there.
   for (Real a = half; a < half + 3; a += 0.0173) {
     for (const Real r : {a, -a}) EXPECT_TRUE(K::N(r) == 0 && (a == half || K::dN(r) == 0)) << r;

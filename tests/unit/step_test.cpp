@@ -104,10 +104,9 @@ TEST_P(StepTest, ThreadCountDoesNotChangeTheResult) {
   for_dim([&]<int Dim>() {
     std::vector<Vec<Dim>> x[2];
     const int cells = Dim == 1 ? 8192 : Dim == 2 ? 128 : 64;
-    // Within the CFL limit dx / c (c = 10 m/s): 1e-4 is 8x over it at 8192 cells,
-    // where only round-off noise (growing at a rate that depends on the transfer)
-    // kept the states finite; a NaN state never compares equal.
-    const Real dt = Dim == 1 ? 1e-5 : 1e-4;
+    // Within the CFL limit: at 8192 cells dt = 1e-4 is ~10x the stable step, and a
+    // run that overflows to NaN has no defined stencil (seen with uGIMP + MLS).
+    const Real dt = Dim == 1 ? 5e-6 : 1e-4;
     for (int threads = 1; threads <= 2; ++threads) {
       omp_set_num_threads(threads);
       run<Dim>(

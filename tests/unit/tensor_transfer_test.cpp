@@ -8,6 +8,7 @@
 #include <random>
 #include <string>
 
+#include "core/policy_hooks.hpp"
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
 #include "kernels/all.hpp"
@@ -69,7 +70,7 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       P.F[0] = Mat<Dim>::Identity() + 0.1 * random_matrix<Dim>(rng);
       const Mat<Dim> tauV = random_matrix<Dim>(rng);
       const Stencil<Dim, Kernel> st(P.x[0], geo);
-      const auto src = policy.prepare(P, 0, tauV);
+      const auto src = prepare_source(policy, P, 0, tauV, st);  // as the solver calls it
 
       // P2G: per node against the sums.
       Grid<Dim> ref(geo), fast(geo);
@@ -89,7 +90,7 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
         ref.v[n] = random_vector<Dim>(rng);
         ref.v_old[n] = random_vector<Dim>(rng);
       }
-      typename Policy::Gather g_ref;
+      auto g_ref = begin_gather(policy, st);
       st.for_each_node(geo, [&](long n, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
         policy.gather(g_ref, w, grad, d, ref.v[n], ref.v_old[n]);
       });
@@ -124,6 +125,7 @@ TEST(TensorTransfer, FastPathMatchesPerNodeMathForEveryTransferKernelAndDimensio
 // support's nodes r_k = r0 - k, over the whole range of the first offset r0.
 TEST(TensorTransfer, KernelWeightsMatchNAndDN) {
   AllKernels::for_each([&]<class K>() {
+    // (uGIMP's weights take the half-width l: here its default, as N and dN.)
     if constexpr (requires(Real * out) { K::weights(Real(1), out, out); }) {
       const Real r_lo = Real(0.5) * (K::support - 2);  // r0 in [r_lo, r_lo + 1)
       for (int i = 0; i <= 1000; ++i) {

@@ -21,10 +21,10 @@ Vec<Dim> interpolate(const Grid<Dim>& g, const Vec<Dim>& x) {
 
 // A 2D body pressed into the lower-left corner: sticky wall at x = 0, slip at y = 0.
 template <class Kernel>
-void check_faces() {
+void check_faces(int ppc = 2) {
   const std::string toml = testing::free_body_toml(
       2, "mls", "quadratic", "[boundary]\nx_min = \"sticky\"\ny_min = \"slip\"\n");
-  Scene scene = testing::scene_from_toml(toml, {.dim = 2});
+  Scene scene = testing::scene_from_toml(toml, {.dim = 2, .ppc = ppc});
   scene.bodies[0].min = Vec3(0, 0, 0);
   scene.bodies[0].velocity = Vec3(-0.4, -0.3, 0);
   State<2> s = build_state<2>(scene);
@@ -58,6 +58,13 @@ TEST(Walls, ConditionHoldsOnTheFaceQuadratic) {
 }
 TEST(Walls, ConditionHoldsOnTheFaceCubic) {
   check_faces<CubicKernel>();
+}
+// uGIMP's support, 1 + l cells, follows the particle half-width l = 1/(2 ppc).
+TEST(Walls, ConditionHoldsOnTheFaceGimp) {
+  for (const int ppc : {1, 2, 4}) {
+    SCOPED_TRACE(::testing::Message() << "ppc " << ppc);
+    check_faces<GimpKernel>(ppc);
+  }
 }
 
 // A separate wall lets material leave: a body moving away keeps its velocity;

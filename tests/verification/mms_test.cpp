@@ -55,7 +55,8 @@ TEST_P(SmallBar, ConvergesAtSecondOrder) {
 
 INSTANTIATE_TEST_SUITE_P(AllKernels, SmallBar,
                          ::testing::Combine(::testing::Values("flip", "apic", "mls"),
-                                            ::testing::Values("linear", "quadratic", "cubic")),
+                                            ::testing::Values("linear", "quadratic", "cubic",
+                                                              "gimp")),
                          combination_name);
 
 TEST(SmallBarPic, ConvergesAtFirstOrderOnly) {
