@@ -8,9 +8,11 @@
 #include "transfers/flip.hpp"
 #include "transfers/mls.hpp"
 #include "transfers/pic.hpp"
+#include "transfers/xpic.hpp"
 
 namespace mpmtb {
 
-using AllTransfers = TypeList<PicTransfer, FlipTransfer, ApicTransfer, MlsTransfer>;
+using AllTransfers = TypeList<PicTransfer, FlipTransfer, ApicTransfer, MlsTransfer,  //
+                              XpicTransfer>;
 
 }  // namespace mpmtb
