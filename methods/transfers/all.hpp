@@ -5,6 +5,7 @@
 
 #include "core/type_list.hpp"
 #include "transfers/apic.hpp"
+#include "transfers/asflip.hpp"
 #include "transfers/flip.hpp"
 #include "transfers/mls.hpp"
 #include "transfers/pic.hpp"
@@ -13,6 +14,7 @@
 namespace mpmtb {
 
 using AllTransfers = TypeList<PicTransfer, FlipTransfer, ApicTransfer, MlsTransfer,  //
-                              XpicTransfer>;
+                              XpicTransfer,                                          //
+                              AflipTransfer, AsflipTransfer>;
 
 }  // namespace mpmtb
