@@ -6,6 +6,7 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <limits>
 #include <string>
 #include <vector>
 
@@ -28,7 +29,14 @@ Outcome run_2d(const Scene& scene, int steps, Real dt) {
   Parameters params = scene.transfer_params;
   auto st = make_stepper<2>(scene.transfer, scene.kernel, params);
   const Diagnostics d0 = measure(s, *st);
-  for (int i = 0; i < steps; ++i) st->step(s, dt);
+  for (int i = 0; i < steps; ++i) {
+    // Stop at the first non-finite or escaped particle (a broken scheme), so
+    // the test fails on NaN instead of binning NaN positions.
+    const StepReport r = st->step(s, dt);
+    if (r.non_finite >= 0 || r.outside >= 0) {
+      return {s.particles.x, s.particles.v, std::numeric_limits<Real>::quiet_NaN()};
+    }
+  }
   const Diagnostics d1 = measure(s, *st);
   return {s.particles.x, s.particles.v, (d1.kinetic + d1.strain) / (d0.kinetic + d0.strain)};
 }
