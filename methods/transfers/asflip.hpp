@@ -2,8 +2,8 @@
 // the Material Point Method: A Scheme for Easier Separation and Less
 // Dissipation", ACM TOG 40(4) 109.
 //   P2G, force       as APIC (affine momentum m_p C_p (x_i - x_p) w_ip)
-//   G2P velocity     v_p <- v_PIC^{n+1} + alpha (v_p^n - v_PIC^n)         (sec. 4.1)
-//   G2P position     x_p <- x_p + dt (v_PIC^{n+1} + beta alpha (v_p^n - v_PIC^n))  (sec. 4.2)
+//   G2P velocity     v_p <- v_PIC^{n+1} + alpha (v_p^n - v_PIC^n)
+//   G2P position     x_p <- x_p + dt (v_PIC^{n+1} + beta alpha (v_p^n - v_PIC^n))
 //   C_p, F update    as APIC
 // with v_PIC = sum w v_i^{n+1}, v_PIC^n = sum w v_i^n (the grid velocity before
 // forces, APIC's affine momentum included). AFLIP is beta = 0 (positions move
@@ -11,8 +11,9 @@
 // particle and beta_min otherwise; a particle counts as separating unless
 // log det F_p^{n+1} < -1e-3 (compressed), the criterion and threshold of the
 // authors' demo (nepluno/pyasflip), which also uses alpha = 0.99, beta_min = 0,
-// beta_max = 1. The demo's extra rule (beta = 0 inside a collider) is not here:
-// this testbed's colliders act on the grid only.
+// beta_max = 1. The demo's extra rule, beta = 0 for a particle in contact with a
+// collider, is kept for pinned particles only (they stay put); this testbed's
+// colliders act on the grid, so particles touching them are not marked.
 // alpha = 0 is APIC exactly. For alpha > 0 the FLIP increment does not keep the
 // affine angular momentum, so the scheme does not claim its conservation.
 // Parameters: [aflip] alpha; [asflip] alpha, beta_min, beta_max, all in [0, 1].
@@ -73,7 +74,11 @@ class AsflipPolicy : public ApicPolicy<Dim, Kernel> {
     P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
     Real beta = 0;
     if constexpr (kSeparation) {
-      beta = std::log(P.F[p].determinant()) < Real(-1e-3) ? beta_min_ : beta_max_;
+      // A pinned particle is held by its nodes: no position correction, as the
+      // demo's beta = 0 for particles in contact with a collider.
+      if (!P.pinned[p]) {
+        beta = std::log(P.F[p].determinant()) < Real(-1e-3) ? beta_min_ : beta_max_;
+      }
     }
     P.x[p] += dt * (g.v + (beta * alpha_) * flip);
   }

@@ -8,10 +8,10 @@
 //   v_p^{n+1} = S (v^{n+1} - v^n + v*),
 //   v* = sum_{k=1..m} (-1)^{k+1} C(m,k) S+ P^{k-1} v_p^n
 //      = sum_{k=1..m} (-1)^{k+1} C(m,k) Q^{k-1} v^n,   Q = S+ S on the grid,
-// since S+ v_p^n = v^n (paper, eqs. 13-19). XPIC(1) is PIC; as m grows the scheme
-// approaches FLIP with only the null-space noise of P removed.
-// The base solver computes the grid series (the m - 1 round trips Q) because
-// this policy declares old_velocity_series(): it replaces v_old_i by
+// since S+ v_p^n = v^n (equation numbers of the paper not checked). XPIC(1) is PIC; as m grows the
+// scheme approaches FLIP with only the null-space noise of P removed. The base solver computes the
+// grid series (the m - 1 round trips Q) because this policy declares old_velocity_series(): it
+// replaces v_old_i by
 //   v^n - v* = sum_{j=0..m-1} d_j Q^j v^n,  d_0 = 1 - m, d_j = (-1)^{j+1} C(m, j+1),
 // so that G2P reads v_p = S (v^{n+1} - v_old) like a FLIP increment.
 // P2G, force, F update and the position (x_p += dt S v^{n+1}) are PIC's.

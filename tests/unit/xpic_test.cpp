@@ -1,6 +1,6 @@
 // XPIC(m) (Hammerquist & Nairn 2017): XPIC(1) is PIC, and on the colliding
 // disks (Sulsky et al. 1994) the energy kept grows with m toward FLIP's, the
-// paper's trend (its fig. 5-6: XPIC(m) moves from PIC's dissipation toward
+// paper's trend (XPIC(m) moves from PIC's dissipation toward
 // FLIP as m grows). The disks run to their scene's end, t = 3.5 s (3500 steps
 // of ~800 particles; about 8 s in Release for the five runs together).
 #include <gtest/gtest.h>
