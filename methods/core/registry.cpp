@@ -46,6 +46,8 @@ std::vector<VariantInfo> transfer_list() {
   std::size_t i = 0;
   AllTransfers::for_each([&]<class T>() {
     out[i].affine = T::affine_momentum;
+    if constexpr (requires { T::positions_follow_momentum; })
+      out[i].positions_follow_momentum = T::positions_follow_momentum;
     out[i++].conserves_angular_momentum = T::conserves_angular_momentum;
   });
   return out;

@@ -33,6 +33,11 @@ class Solver final : public Stepper<Dim> {
       return 0;
     }
   }();
+  // A policy that declares old_velocity_series() has the grid update replace
+  // v_old by a polynomial in the particle projection (filter_old_velocity; XPIC).
+  static constexpr bool kFiltersOldVelocity = requires(const Policy& q) {
+    q.old_velocity_series();
+  };
 
  public:
   Solver(Parameters& transfer_params) : transfer_params_(transfer_params) {}
@@ -85,6 +90,7 @@ class Solver final : public Stepper<Dim> {
       }
     }
     s.pin_impulse += Vec3(rx, ry, rz);
+    if constexpr (kFiltersOldVelocity) filter_old_velocity(s);
     s.walls.apply(g);
     if (!s.colliders.empty())
       s.colliders.apply(g, s.time + dt, s.collider_impulse, s.collider_work);
@@ -405,6 +411,67 @@ class Solver final : public Stepper<Dim> {
         StencilT(P.x[p], g.geo), g.geo, form, g.m.data(), g.p.data(), g.f.data());
   }
 
+  // v_old <- sum_j c_j Q^j v_old, c = the policy's old_velocity_series(), with
+  // Q = S+ S the particle projection of a nodal field: interpolate it to the
+  // particles (S, u_p = sum_i w_ip u_i), scatter it back mass-weighted
+  // (S+, u_i = sum_p w_ip m_p u_p / sum_p w_ip m_p). The scatter runs over P2G's
+  // blocks and colours (the particles have not moved since), so the result does
+  // not depend on the thread count. Particles and nodes as in this step's P2G.
+  void filter_old_velocity(State<Dim>& s) {
+    Grid<Dim>& g = s.grid;
+    const Particles<Dim>& P = s.particles;
+    const std::vector<Real> c = Policy(transfer_params_, g.geo.dx).old_velocity_series();
+    const long n = static_cast<long>(P.size());
+    if (c.size() > 1) {
+      q_field_.resize(g.size()), q_sum_.resize(g.size()), q_mass_.resize(g.size());
+      q_particle_.resize(n);
+    }
+    for_each_active_node(g, [&](long i) {
+      if (c.size() > 1) q_field_[i] = g.v_old[i];
+      g.v_old[i] *= c[0];
+    });
+    for (std::size_t j = 1; j < c.size(); ++j) {
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+      for (long p = 0; p < n; ++p) {
+        q_particle_[p] = TensorTransfer<Dim, Kernel>::template gather<TensorTerms{}>(
+                             StencilT(P.x[p], g.geo), g.geo, q_field_.data(), nullptr)
+                             .v;
+      }
+      const bool with_mass = j == 1;  // the nodal masses of S+ do not change within the step
+      for_each_active_node(g, [&](long i) {
+        q_sum_[i].setZero();
+        if (with_mass) q_mass_[i] = 0;
+      });
+      for_each_particle_coloured(s, [&](int p) {
+        StencilT(P.x[p], g.geo)
+            .for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+              const Real wm = w * P.m[p];
+              q_sum_[node] += wm * q_particle_[p];
+              if (with_mass) q_mass_[node] += wm;
+            });
+      });
+      for_each_active_node(g, [&](long i) {
+        if (q_mass_[i] > 0) {
+          q_field_[i] = q_sum_[i] / q_mass_[i];
+        } else {
+          q_field_[i].setZero();
+        }
+        g.v_old[i] += c[j] * q_field_[i];
+      });
+    }
+  }
+
+  // f(node) for every node of the active box, in parallel over its rows.
+  template <class F>
+  static void for_each_active_node(const Grid<Dim>& g, F&& f) {
+    const long rows = g.active_rows();
+#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      for (long i = first; i < first + count; ++i) f(i);
+    }
+  }
+
   Parameters transfer_params_;
   std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
   std::vector<Vec<Dim>> p_kept_;
@@ -414,6 +481,9 @@ class Solver final : public Stepper<Dim> {
   static constexpr int kColours = 1 << kColouredAxes;
   std::vector<std::array<int, kColouredAxes>> first_;  // first stencil node per coloured axis
   std::vector<int> block_of_, block_start_, block_order_, fill_;
+  // Scratch of filter_old_velocity: nodal field, sums and masses; particle values.
+  std::vector<Vec<Dim>> q_field_, q_sum_, q_particle_;
+  std::vector<Real> q_mass_;
   NonlocalLaplacian<Dim, Kernel> nonlocal_;
 };
 

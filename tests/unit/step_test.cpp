@@ -27,6 +27,11 @@ class StepTest : public ::testing::TestWithParam<Combination> {
     auto stepper = make_stepper<Dim>(c.transfer, c.kernel, params);
     check(s, *stepper, scene);
   }
+  bool positions_follow_momentum() const {
+    for (const auto& t : transfer_list())
+      if (t.name == GetParam().transfer) return t.positions_follow_momentum;
+    return true;
+  }
   template <class F>
   void for_dim(F&& f) {
     testing::with_dim(GetParam().dim, f);
@@ -73,9 +78,10 @@ TEST_P(StepTest, FreeFlightConservesMomentum) {
 // v_n = v_0 + n dt g, x_n = x_0 + n dt v_0 + n (n + 1) / 2 dt^2 g, which differs
 // from the parabola x_0 + v_0 t + g t^2 / 2 by g dt t / 2.
 TEST_P(StepTest, FreeFallFollowsTheParabola) {
+  const bool follows = positions_follow_momentum();
   for_dim([&]<int Dim>() {
     run<Dim>(
-        [](State<Dim>& s, Stepper<Dim>& st, const Scene& scene) {
+        [follows](State<Dim>& s, Stepper<Dim>& st, const Scene& scene) {
           const Diagnostics d0 = measure(s, st);
           const Vec3 g = scene.gravity;
           const Real dt = 1e-3;
@@ -87,8 +93,9 @@ TEST_P(StepTest, FreeFallFollowsTheParabola) {
           const Vec3 discrete = x0 + t * v0 + Real(n * (n + 1)) / 2 * dt * dt * g;
           const Vec3 parabola = x0 + t * v0 + Real(0.5) * t * t * g;
           for (int a = 0; a < Dim; ++a) {
-            EXPECT_NEAR(d.center_of_mass[a], discrete[a], 1e-12);
             EXPECT_NEAR(d.center_of_mass_velocity[a], v0[a] + t * g[a], 1e-11);
+            if (!follows) continue;  // ASFLIP: see its header
+            EXPECT_NEAR(d.center_of_mass[a], discrete[a], 1e-12);
             EXPECT_NEAR(d.center_of_mass[a], parabola[a], std::abs(g[a]) * dt * t / 2 + 1e-12);
           }
           EXPECT_GT((discrete - x0).norm(), 1e-3) << "the body must actually fall";
