@@ -113,18 +113,22 @@ def save_figure(fig, path):
 
 # ----------------------------------------------------------------- style --
 
-TRANSFERS = ("pic", "flip", "apic", "mls")
-KERNELS = ("linear", "quadratic", "cubic")
+TRANSFERS = ("pic", "flip", "apic", "mls", "tpic", "polypic", "xpic", "aflip",
+             "asflip")
+KERNELS = ("linear", "quadratic", "cubic", "gimp")
 TRANSFER_COLOURS = {"pic": "tab:blue", "flip": "tab:orange",
-                    "apic": "tab:green", "mls": "tab:red"}
-KERNEL_LINESTYLES = {"linear": ":", "quadratic": "-", "cubic": "-."}
-KERNEL_HATCHES = {"linear": "..", "quadratic": "", "cubic": "//"}
+                    "apic": "tab:green", "mls": "tab:red",
+                    "tpic": "tab:purple", "polypic": "tab:brown",
+                    "xpic": "tab:pink", "aflip": "tab:olive",
+                    "asflip": "tab:cyan"}
+KERNEL_LINESTYLES = {"linear": ":", "quadratic": "-", "cubic": "-.",
+                     "gimp": (0, (5, 1))}
+KERNEL_HATCHES = {"linear": "..", "quadratic": "", "cubic": "//", "gimp": "xx"}
 # Black and "--" are kept for exact / reference curves.
 EXACT_STYLE = {"color": "black", "linestyle": "--", "linewidth": 1.2}
-_SPARE_COLOURS = ("tab:purple", "tab:brown", "tab:pink", "tab:olive",
-                  "tab:cyan", "tab:gray")
-_SPARE_LINESTYLES = ((0, (5, 1)), (0, (3, 1, 1, 1, 1, 1)), (0, (1, 3)))
-_SPARE_HATCHES = ("xx", "\\\\", "oo")
+_SPARE_COLOURS = ("tab:gray", "gold", "navy", "lime")
+_SPARE_LINESTYLES = ((0, (3, 1, 1, 1, 1, 1)), (0, (1, 3)))
+_SPARE_HATCHES = ("\\\\", "oo")
 
 
 def _pick(name, table, spares):

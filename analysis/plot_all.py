@@ -39,6 +39,7 @@ class Sweep:
         header, rows = mp.read_table(csv_path)
         check_runs(csv_path, header, rows)
         self.error_columns = [c for c in header if c.startswith("error_")]
+        self.measured_columns = [c for c in header if c.startswith("measured_")]
         self.runs = sorted((mp.Run(row, self.dir) for row in rows),
                            key=mp.run_order)
         self.figures = []
@@ -65,7 +66,7 @@ def check_runs(path, header, rows):
     if missing:
         raise mp.DataError(f"{path}: missing column(s) {', '.join(missing)}")
     numeric = list(NUMERIC_COLUMNS) + [c for c in header
-                                       if c.startswith("error_")]
+                                       if c.startswith(("error_", "measured_"))]
     seen = set()
     for line, row in enumerate(rows, start=2):
         where = f"{path}: row {line} (run '{row['run']}')"
@@ -263,7 +264,7 @@ def cell(text):
 def runs_table(sweep):
     """Markdown table of a sweep's runs.csv."""
     head = ["run", "status", "reason", "particles", "steps",
-            "particle-steps/s"] + sweep.error_columns + ["drift_energy"]
+            "particle-steps/s"] + sweep.error_columns + sweep.measured_columns + ["drift_energy"]
     lines = ["| " + " | ".join(head) + " |",
              "|" + "---|" * 2 + "---|" + "--:|" * (len(head) - 3)]
     for run in sweep.runs:
@@ -273,6 +274,7 @@ def runs_table(sweep):
                  fmt(run.value("steps"), "int"),
                  fmt(run.value("particle_steps_per_second"), "sig3")]
         cells += [fmt(run.value(c), ".2e") for c in sweep.error_columns]
+        cells += [fmt(run.value(c), "sig3") for c in sweep.measured_columns]
         cells.append(fmt(run.value("drift_energy"), ".2e"))
         lines.append("| " + " | ".join(cells) + " |")
     return lines

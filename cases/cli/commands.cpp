@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <array>
 #include <iostream>
 #include <set>
 
@@ -20,22 +21,25 @@ std::string number_field(const nlohmann::json& j, const char* key) {
   return j.contains(key) && j[key].is_number() ? fmt::format("{:.10g}", j[key].get<double>()) : "";
 }
 
-// DIR/runs.csv: one row per combination, the error norms as error_<name> columns.
+// DIR/runs.csv: one row per combination; the error norms against the reference
+// as error_<name> columns and what the case measured (bar: period; column:
+// run-out) as measured_<name> columns, numbers only.
 void write_runs_table(const std::filesystem::path& dir,
                       const std::vector<std::pair<std::string, RunOutcome>>& runs) {
-  std::set<std::string> error_names;
+  const std::array<std::string, 2> groups = {"error", "measured"};
+  std::array<std::set<std::string>, 2> names;
   for (const auto& [name, r] : runs) {
-    if (r.summary.contains("error")) {
-      for (const auto& [k, v] : r.summary["error"].items()) error_names.insert(k);
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      if (!r.summary.contains(groups[g]) || !r.summary[groups[g]].is_object()) continue;
+      for (const auto& [k, v] : r.summary[groups[g]].items())
+        if (v.is_number()) names[g].insert(k);
     }
   }
   std::string out =
       "run,transfer,kernel,dim,status,reason,particles,steps,wall_seconds,"
       "particle_steps_per_second,drift_energy,drift_momentum,drift_angular_momentum,drift_volume";
-  for (const auto& e : error_names) {
-    out += ",error_";
-    out += e;
-  }
+  for (std::size_t g = 0; g < groups.size(); ++g)
+    for (const auto& e : names[g]) out += fmt::format(",{}_{}", groups[g], e);
   out += '\n';
   for (const auto& [name, r] : runs) {
     const auto& j = r.summary;
@@ -47,10 +51,12 @@ void write_runs_table(const std::filesystem::path& dir,
         number_field(j, "wall_seconds"), number_field(j, "particle_steps_per_second"),
         number_field(drift, "energy"), number_field(drift, "momentum"),
         number_field(drift, "angular_momentum"), number_field(drift, "volume"));
-    const nlohmann::json err = j.value("error", nlohmann::json::object());
-    for (const auto& e : error_names) {
-      out += ',';
-      out += number_field(err, e.c_str());
+    for (std::size_t g = 0; g < groups.size(); ++g) {
+      const nlohmann::json values = j.value(groups[g], nlohmann::json::object());
+      for (const auto& e : names[g]) {
+        out += ',';
+        out += values.is_object() ? number_field(values, e.c_str()) : "";
+      }
     }
     out += '\n';
   }

@@ -4,6 +4,8 @@
 // particles, so the loops do run in parallel.
 #include <gtest/gtest.h>
 
+#include <string>
+
 #include <cmath>
 
 #include "core/types.hpp"
@@ -87,14 +89,24 @@ TEST_P(Determinism, SameThreadsBitIdenticalAcrossThreadsToRoundOff) {
   expect_close(a.summary, one.summary, 1e-10, 1e-2);
 }
 
+std::string SceneName(const ::testing::TestParamInfo<std::string>& info) {
+  static const char* const names[] = {"rotating", "pinned_block", "rotating_xpic",
+                                      "rotating_polypic"};
+  return names[info.index];
+}
+
 INSTANTIATE_TEST_SUITE_P(
     Scenes, Determinism,
     ::testing::Values(
         // 2D spinning square, affine transfer: 5,776 particles.
         "rotating --cells 64 --ppc 4 --t-end 0.03",
         // A pinned strip struck by a collider, FLIP: pins and colliders reduce over nodes.
-        "pinned_block --transfer flip --cells 32 --t-end 0.004 --set time.output_interval=0.001"),
-    [](const auto& info) { return info.index == 0 ? "rotating" : "pinned_block"; });
+        "pinned_block --transfer flip --cells 32 --t-end 0.004 --set time.output_interval=0.001",
+        // The extra passes of XPIC (grid projections in P2G's colour order) and
+        // PolyPIC's per-particle transfer state.
+        "rotating --transfer xpic --cells 64 --ppc 4 --t-end 0.03",
+        "rotating --transfer polypic --cells 64 --ppc 4 --t-end 0.03"),
+    SceneName);
 
 }  // namespace
 }  // namespace mpmtb

@@ -18,6 +18,7 @@
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
 #include "kernels/gimp.hpp"
+#include "kernels/quadratic.hpp"
 #include "run.hpp"
 #include "setup.hpp"
 #include "support/convergence.hpp"
@@ -97,6 +98,16 @@ TEST(GimpKernel, SmallHalfWidthTendsToTheHat) {
     for (Real r = -1.3; r <= 1.3; r += 1e-4) gap = std::max(gap, std::abs(K::N(r, l) - Hat(r)));
     EXPECT_LE(gap, l / 2 + 1e-12) << "l=" << l;
     EXPECT_GE(gap, l / 2 - 1e-3 * l) << "l=" << l;  // attained near r = 0
+  }
+}
+
+// With one particle per cell (l = 1/2) the particle domains are whole cells, and the
+// hat averaged over a cell is the quadratic B-spline (B-splines: B_{n+1} = B_n
+// convolved with the unit box), so the two kernels coincide: values and slopes.
+TEST(GimpKernel, OneParticlePerCellIsTheQuadraticBSpline) {
+  for (Real r = -1.6; r <= 1.6; r += 1.37e-3) {
+    EXPECT_NEAR(K::N(r, Real(0.5)), QuadraticKernel::N(r), 1e-14) << "r=" << r;
+    EXPECT_NEAR(K::dN(r, Real(0.5)), QuadraticKernel::dN(r), 1e-13) << "r=" << r;
   }
 }
 
