@@ -111,8 +111,8 @@ struct ApicTransfer {
       "APIC: affine momentum C_p, kernel-gradient force and F (Jiang et al. 2015); "
       "linear: C_p = sum v_i grad w^T; gimp: the particle's own D_p";
   static constexpr bool affine_momentum = true;
-  // Claims angular momentum conservation, the affine part included, in both
-  // transfers (the conformance tests hold it to round-off).
+  // Whether the paper claims angular momentum conservation, affine part included, in both
+  // transfers (if so, the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = true;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>

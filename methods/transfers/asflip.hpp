@@ -102,8 +102,8 @@ struct AflipTransfer {
       "AFLIP: APIC with the FLIP velocity increment blended in by aflip.alpha (default 0.99; "
       "Fei et al. 2021); alpha = 0 is APIC";
   static constexpr bool affine_momentum = true;
-  // Claims angular momentum conservation, the affine part included, in both
-  // transfers (the conformance tests hold it to round-off).
+  // Whether the paper claims angular momentum conservation, affine part included, in both
+  // transfers (if so, the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = false;
   static constexpr bool needs_old_velocity = true;
   template <class Kernel>
@@ -119,8 +119,8 @@ struct AsflipTransfer {
       "ASFLIP: AFLIP whose separating particles also move by beta x the FLIP increment "
       "(Fei et al. 2021); asflip.alpha 0.99, beta_min 0, beta_max 1";
   static constexpr bool affine_momentum = true;
-  // Claims angular momentum conservation, the affine part included, in both
-  // transfers (the conformance tests hold it to round-off).
+  // Whether the paper claims angular momentum conservation, affine part included, in both
+  // transfers (if so, the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = false;
   static constexpr bool needs_old_velocity = true;
   // beta_p differs between particles, so sum m_p x_p does not advance by

@@ -53,8 +53,8 @@ struct FlipTransfer {
   static constexpr std::string_view description =
       "FLIP(alpha): grid velocity increments, blended with PIC by flip.alpha (default 1)";
   static constexpr bool affine_momentum = false;
-  // Claims angular momentum conservation, the affine part included, in both
-  // transfers (the conformance tests hold it to round-off).
+  // Whether the paper claims angular momentum conservation, affine part included, in both
+  // transfers (if so, the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = false;
   static constexpr bool needs_old_velocity = true;
   template <class Kernel>

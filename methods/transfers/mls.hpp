@@ -87,8 +87,8 @@ struct MlsTransfer {
       "MLS-MPM: APIC with the MLS force and F from C (Hu et al. 2018); linear: gradient form; "
       "gimp: the particle's own D_p";
   static constexpr bool affine_momentum = true;
-  // Claims angular momentum conservation, the affine part included, in both
-  // transfers (the conformance tests hold it to round-off).
+  // Whether the paper claims angular momentum conservation, affine part included, in both
+  // transfers (if so, the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = true;
   static constexpr bool needs_old_velocity = false;
   // F is updated from C_p and the MLS force is fused with the affine momentum,

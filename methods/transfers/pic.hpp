@@ -72,8 +72,8 @@ struct PicTransfer {
   static constexpr std::string_view description =
       "PIC: particle velocity replaced by the grid's (Sulsky et al. 1994); dissipative";
   static constexpr bool affine_momentum = false;
-  // Claims angular momentum conservation, the affine part included, in both
-  // transfers (the conformance tests hold it to round-off).
+  // Whether the paper claims angular momentum conservation, affine part included, in both
+  // transfers (if so, the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = false;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>

@@ -85,8 +85,8 @@ struct XpicTransfer {
       "XPIC(m): PIC with the first m terms of FLIP's grid projection series "
       "(Hammerquist & Nairn 2017); xpic.m (default 5), m = 1 is PIC";
   static constexpr bool affine_momentum = false;
-  // Claims angular momentum conservation, the affine part included, in both
-  // transfers (the conformance tests hold it to round-off).
+  // Whether the paper claims angular momentum conservation, affine part included, in both
+  // transfers (if so, the conformance tests hold it to round-off).
   static constexpr bool conserves_angular_momentum = false;
   static constexpr bool needs_old_velocity = true;
   template <class Kernel>

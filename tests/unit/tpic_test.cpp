@@ -10,23 +10,14 @@
 namespace mpmtb {
 namespace {
 
-std::string spinning(int dim) {
-  return "[scene]\nname = \"spin\"\ndim = " + std::to_string(dim) +
-         "\ndims = [2, 3]\n[domain]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\n"
-         "[grid]\ncells = 32\nppc = 2\n[method]\ntransfer = \"apic\"\nkernel = \"quadratic\"\n"
-         "[time]\nt_end = 1.0\ndt = 1e-3\n"
-         "[materials.jelly]\nmodel = \"neo-hookean\"\nE = 2e4\nnu = 0.3\ndensity = 1000.0\n"
-         "[[bodies]]\nshape = \"box\"\nmin = [0.35, 0.35, 0.35]\nmax = [0.65, 0.65, 0.65]\n"
-         "material = \"jelly\"\nangular_velocity = [0.3, -0.2, 1.0]\n";
-}
-
 template <int Dim>
 struct SpinRun {
   Scene scene;
   State<Dim> s;
   std::unique_ptr<Stepper<Dim>> st;
   SpinRun(const std::string& transfer, const std::string& kernel) {
-    scene = testing::scene_from_toml(spinning(Dim), {.transfer = transfer, .kernel = kernel});
+    scene = testing::scene_from_toml(testing::spinning_body_toml(Dim),
+                                     {.transfer = transfer, .kernel = kernel});
     s = build_state<Dim>(scene);
     Parameters params = scene.transfer_params;
     st = make_stepper<Dim>(transfer, kernel, params);

@@ -134,23 +134,13 @@ INSTANTIATE_TEST_SUITE_P(AffineCombinations, AffineTransferTest,
                              {2, 3}, testing::Transfers::conserving_angular_momentum)),
                          testing::combination_name);
 
-std::string rotating(int dim) {
-  return "[scene]\nname = \"spin\"\ndim = " + std::to_string(dim) +
-         "\ndims = [2, 3]\n[domain]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\n"
-         "[grid]\ncells = 32\nppc = 2\n[method]\ntransfer = \"apic\"\nkernel = \"quadratic\"\n"
-         "[time]\nt_end = 1.0\ndt = 1e-3\n"
-         "[materials.jelly]\nmodel = \"neo-hookean\"\nE = 2e4\nnu = 0.3\ndensity = 1000.0\n"
-         "[[bodies]]\nshape = \"box\"\nmin = [0.35, 0.35, 0.35]\nmax = [0.65, 0.65, 0.65]\n"
-         "material = \"jelly\"\nangular_velocity = [0.3, -0.2, 1.0]\n";
-}
-
 // The free spinning body: PIC's projection loses angular momentum and kinetic
 // energy; APIC and MLS-MPM keep angular momentum to round-off.
 TEST(RotatingBody, PicDissipatesAffineTransfersConserve) {
   for (int dim : {2, 3}) {
     testing::with_dim(dim, [&]<int Dim>() {
       for (const char* transfer : {"pic", "apic", "mls"}) {
-        auto u = make_setup<Dim>(rotating(Dim), transfer, "quadratic");
+        auto u = make_setup<Dim>(testing::spinning_body_toml(Dim), transfer, "quadratic");
         const Diagnostics d0 = measure(u.s, *u.st);
         for (int i = 0; i < 100; ++i) u.st->step(u.s, 1e-3);
         const Diagnostics d1 = measure(u.s, *u.st);
@@ -172,7 +162,7 @@ TEST(RotatingBody, PicDissipatesAffineTransfersConserve) {
 template <int Dim>
 std::vector<Vec<Dim>> positions_after(const std::string& transfer, const std::string& kernel,
                                       const std::vector<std::string>& set = {}) {
-  auto u = make_setup<Dim>(rotating(Dim), transfer, kernel, {.set = set});
+  auto u = make_setup<Dim>(testing::spinning_body_toml(Dim), transfer, kernel, {.set = set});
   for (int i = 0; i < 50; ++i) u.st->step(u.s, 1e-3);
   return u.s.particles.x;
 }
@@ -191,7 +181,7 @@ TEST(TransferIdentities, MlsWithTheLinearHatIsApic) {
 
 TEST(TransferParameters, FlipAlphaOutOfRangeIsRejected) {
   try {
-    make_setup<2>(rotating(2), "flip", "quadratic", {.set = {"flip.alpha=1.5"}});
+    make_setup<2>(testing::spinning_body_toml(2), "flip", "quadratic", {.set = {"flip.alpha=1.5"}});
     ADD_FAILURE() << "accepted alpha = 1.5";
   } catch (const InputError& e) {
     EXPECT_NE(std::string(e.what()).find("flip.alpha"), std::string::npos) << e.what();
