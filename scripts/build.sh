@@ -3,5 +3,6 @@
 set -euo pipefail
 cd "$(dirname "$0")/.."
 bash scripts/setup-deps.sh
-cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMPMTB_WERROR=ON "$@" >/dev/null
+source scripts/ccache.sh
+cmake -S . -B build -DCMAKE_BUILD_TYPE=Release -DMPMTB_WERROR=ON "${launcher[@]}" "$@" >/dev/null
 cmake --build build -j "$(nproc)"

@@ -10,9 +10,10 @@ cd "$(dirname "$0")/.."
 runs=${1:-200000} seconds=${2:-120}
 cxx=${CXX_FUZZ:-clang++}
 command -v "$cxx" >/dev/null || { echo "fuzz: $cxx not found; skipped" >&2; exit 0; }
+source scripts/ccache.sh
 cmake -S . -B build-fuzz -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
   -DCMAKE_CXX_FLAGS_DEBUG="-O1 -g" -DMPMTB_SANITIZE=address,undefined,fuzzer-no-link \
-  -DMPMTB_FUZZ=ON -DMPMTB_BUILD_BENCH=OFF >/dev/null
+  -DMPMTB_FUZZ=ON -DMPMTB_BUILD_BENCH=OFF "${launcher[@]}" >/dev/null
 cmake --build build-fuzz -j "$(nproc)" --target mpmtb_scene_fuzz
 mkdir -p build-fuzz/corpus
 cd build-fuzz

@@ -2,7 +2,7 @@
 # Installs the Debian packages mpmtb needs, if any is missing (Debian 12).
 # Runs apt-get as root, or through sudo; does nothing when all are present.
 set -euo pipefail
-packages=(g++ make cmake libeigen3-dev libfmt-dev libcli11-dev libtomlplusplus-dev
+packages=(g++ make cmake ccache libeigen3-dev libfmt-dev libcli11-dev libtomlplusplus-dev
           nlohmann-json3-dev libgtest-dev libbenchmark-dev python3-matplotlib python3-numpy
           python3-vtk9)
 # python3-vtk9 (about 60 packages, 250 MB installed: Qt, MPI) only lets the frame
