@@ -16,12 +16,31 @@ cmake -S . -B build-asan -DCMAKE_BUILD_TYPE=Debug -DCMAKE_CXX_FLAGS_DEBUG="-O1 -
 cmake --build build-asan -j "$(nproc)" --target mpmtb mpmtb_unit_tests
 export ASAN_OPTIONS=abort_on_error=0:detect_leaks=1:strict_string_checks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
-heavy='ThreadCountDoesNotChangeTheResult/[23]d|RotatingBody|MlsWithTheLinearHatIsApic'
-heavy+='|RigidTranslationMakesNoStrainEnergy/3d|Determinism|GimpRuns'
+# gtest patterns of the left-out tests (see above).
+heavy='*ThreadCountDoesNotChangeTheResult/2d*:*ThreadCountDoesNotChangeTheResult/3d*'
+heavy+=':RotatingBody.*:TransferIdentities.MlsWithTheLinearHatIsApic:*Determinism*:GimpRuns.*'
+heavy+=':*RigidTranslationMakesNoStrainEnergy/3d*'
 # Runs of many steps whose per-step code the short tests above already cover.
-heavy+='|Xpic.EnergyKept|Polypic.KeepsAtLeast|Tpic.WithTheLinearHat|Tpic.AngularMomentumDrift'
+heavy+=':Xpic.EnergyKept*:Polypic.KeepsAtLeast*:Tpic.WithTheLinearHat*:Tpic.AngularMomentumDrift*'
 # Free flight under every order: the 1D cases run the same stages.
-heavy+='|FreeFlightConservesMassAndMomentum/[23]d'
-cd build-asan
-ctest -L unit -E "$heavy" --output-on-failure -j "$(nproc)"
+heavy+=':*FreeFlightConservesMassAndMomentum/2d*:*FreeFlightConservesMassAndMomentum/3d*'
+# One process per shard, not one per test: each sanitized process costs about a
+# second to start, which over a thousand tests would dominate the stage.
+cd build-asan/tests
+shards=$(nproc)
+pids=()
+for ((k = 0; k < shards; ++k)); do
+  GTEST_TOTAL_SHARDS=$shards GTEST_SHARD_INDEX=$k ./mpmtb_unit_tests --gtest_filter="-$heavy" \
+    --gtest_brief=1 >"shard$k.log" 2>&1 &
+  pids+=($!)
+done
+failed=0
+for ((k = 0; k < shards; ++k)); do
+  if ! wait "${pids[k]}"; then
+    failed=1
+    cat "shard$k.log"
+  fi
+  tail -n 3 "shard$k.log"
+done
 echo "sanitizer stage: $(( $(date +%s) - start )) s"
+[ "$failed" -eq 0 ] || { echo "sanitizer stage: failures (see above)"; exit 1; }

@@ -121,7 +121,13 @@ resume)
   done
   kill -9 "$pid"
   wait "$pid" 2>/dev/null || true
-  sleep 0.2  # the children die with the suite (PR_SET_PDEATHSIG)
+  # The children die with the suite (PR_SET_PDEATHSIG); under load that takes a
+  # moment, and a child must not finish a run after the count below.
+  for _ in $(seq 1 200); do
+    pgrep -f -- "--out $work/b/" >/dev/null || break
+    sleep 0.05
+  done
+  sleep 0.2
   find "$runs" -name done.json | sort | xargs md5sum > "$work/before.md5"
   finished=$(wc -l < "$work/before.md5")
   total=$(find "$work/a/convergence/runs" -name done.json | wc -l)
