@@ -11,6 +11,7 @@
 #include "kernels/all.hpp"
 #include "run.hpp"
 #include "setup.hpp"
+#include "support/cli.hpp"
 #include "support/combinations.hpp"
 #include "support/scenes.hpp"
 #include "transfers/polypic.hpp"
@@ -153,26 +154,7 @@ Real energy_kept(const std::string& transfer) {
   options.threads = 1;
   const RunOutcome r = run_scene(scene, dir, options);
   EXPECT_EQ(r.status, "ok") << r.reason;
-  std::ifstream in(dir / "series.csv");
-  std::string header, line, first, last;
-  std::getline(in, header);
-  std::getline(in, first);
-  while (std::getline(in, line)) last = line;
-  auto split = [](const std::string& row) {
-    std::vector<std::string> cells;
-    std::stringstream ss(row);
-    for (std::string c; std::getline(ss, c, ',');) cells.push_back(c);
-    return cells;
-  };
-  const auto names = split(header);
-  auto energy = [&](const std::string& row) {
-    const auto cells = split(row);
-    Real e = 0;
-    for (std::size_t i = 0; i < names.size(); ++i)
-      if (names[i] == "kinetic" || names[i] == "strain") e += std::stod(cells[i]);
-    return e;
-  };
-  return energy(last) / energy(first);
+  return testing::series_ratio(dir / "series.csv", {"kinetic", "strain"});
 }
 
 TEST(Polypic, KeepsAtLeastApicsEnergyOnTheDisks) {

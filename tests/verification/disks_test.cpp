@@ -8,6 +8,7 @@
 #include <sstream>
 
 #include "run.hpp"
+#include "support/csv.hpp"
 
 namespace mpmtb {
 namespace {
@@ -19,18 +20,7 @@ Real energy_kept(const std::string& transfer, int cells) {
       std::filesystem::temp_directory_path() / ("mpmtb_disks_" + transfer + std::to_string(cells));
   const RunOutcome r = run_scene(scene, dir);
   EXPECT_EQ(r.status, "ok") << r.reason;
-  std::ifstream in(dir / "series.csv");
-  std::string header, line, first, last;
-  std::getline(in, header);
-  std::getline(in, first);
-  while (std::getline(in, line)) last = line;
-  auto total = [](const std::string& row) {  // column 5: total energy
-    std::stringstream ss(row);
-    std::string cell;
-    for (int i = 0; i <= 5; ++i) std::getline(ss, cell, ',');
-    return std::stod(cell);
-  };
-  return total(last) / total(first);
+  return testing::series_ratio(dir / "series.csv", {"total"});
 }
 
 TEST(Disks, EnergyKeptFollowsThePublishedOrdering) {
