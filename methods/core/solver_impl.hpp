@@ -8,6 +8,7 @@
 #include <cmath>
 #include <cstdint>
 #include <limits>
+#include <utility>
 
 #include "core/nonlocal.hpp"
 #include "core/policy_hooks.hpp"
@@ -54,6 +55,7 @@ class Solver final : public Stepper<Dim> {
     bin_particles_into_blocks(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
     for_each_particle_coloured(s, [&](int p) { scatter_particle<true>(s, policy, p); });
+    if constexpr (kTensorPath) unpack_sums<true, true>(s.grid);
   }
 
   void update_grid(State<Dim>& s, Real dt) override {
@@ -110,6 +112,7 @@ class Solver final : public Stepper<Dim> {
     const Grid<Dim>& g = s.grid;
     const Policy policy(transfer_params_, g.geo.dx);
     P.use_transfer_state(kTransferState);
+    if constexpr (kTensorPath) pack_velocities(rows_, g, g.v.data(), g.v_old.data());
     const long n = static_cast<long>(P.size());
     Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min, v_max = 0;
     long non_finite = n, outside = n;
@@ -123,7 +126,7 @@ class Solver final : public Stepper<Dim> {
       if constexpr (kTensorPath) {
         gather =
             policy.gather_from(TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(
-                st, g.geo, g.v.data(), g.v_old.data()));
+                st, g.geo, rows_.data()));
       } else {
         gather = begin_gather(policy, st);  // core/policy_hooks.hpp
         st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
@@ -185,11 +188,18 @@ class Solver final : public Stepper<Dim> {
     bin_particles_into_blocks(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
     for_each_particle_coloured(s, [&](int p) { scatter_particle<false>(s, policy, p); });
+    if constexpr (kTensorPath) {
+      unpack_sums<true, false>(s.grid);  // kept for scatter_forces (usf); musl has none
+      sums_kept_ = true;
+    }
   }
-  // Force, on the blocks scatter_momentum binned (the particles have not moved).
+  // Force, on the blocks scatter_momentum binned (the particles have not moved),
+  // added to the momentum sums that scatter_momentum left.
   void scatter_forces(State<Dim>& s) override {
     compute_stresses(s);
     for_each_particle_coloured(s, [&](int p) { scatter_force(s, p); });
+    unpack_sums<kTensorPath, true>(s.grid);
+    sums_kept_ = false;
   }
 
   // v_i = p_i / m_i with walls, pinned nodes and colliders, for the F update.
@@ -236,6 +246,7 @@ class Solver final : public Stepper<Dim> {
   StepReport update_deformation(State<Dim>& s, Real dt) override {
     Particles<Dim>& P = s.particles;
     const Grid<Dim>& g = s.grid;
+    pack_velocities(v_rows_, g, g.v.data(), nullptr);
     const long n = static_cast<long>(P.size());
     Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min;
     long non_finite = n;
@@ -247,7 +258,7 @@ class Solver final : public Stepper<Dim> {
       const StencilT st(P.x[p], g.geo);
       const Mat<Dim> G =
           TensorTransfer<Dim, Kernel>::template gather<TensorTerms{.gradient = true}>(
-              st, g.geo, g.v.data(), g.v_old.data())
+              st, g.geo, v_rows_.data())
               .G;
       P.F[p] = (Mat<Dim>::Identity() + dt * G) * P.F[p];
       const Real J = P.F[p].determinant();
@@ -268,7 +279,11 @@ class Solver final : public Stepper<Dim> {
 
   // Zeroes every nodal field over the active box of the previous step: the grid
   // is zero everywhere before the scatter, at a cost that follows the particles.
-  static void clear_active_box(Grid<Dim>& g) {
+  // The scatter's sums are zero outside the calls that fill and drain them, but
+  // for those that scatter_momentum kept and no scatter_forces drained (musl).
+  void clear_active_box(Grid<Dim>& g) {
+    if (sums_.values.size() != g.size() * NodeSums<Dim>::N) sums_.reset(g.size());
+    const bool clear_sums = std::exchange(sums_kept_, false);
     const long rows = g.active_rows();
 #pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
     for (long r = 0; r < rows; ++r) {
@@ -279,6 +294,32 @@ class Solver final : public Stepper<Dim> {
       std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
       std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
       std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
+      if (clear_sums) sums_.clear(first, count);
+    }
+  }
+
+  // m_i, p_i, f_i <- the scatter's sums over the active box (NodeSums::unpack).
+  template <bool kMomentum, bool kDrain>
+  void unpack_sums(Grid<Dim>& g) {
+    const long rows = g.active_rows();
+#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      sums_.template unpack<kMomentum, kDrain>(first, count, g.m.data(), g.p.data(), g.f.data());
+    }
+  }
+
+  // The gathers' input: v and v_old (if the rows hold it) packed over the active
+  // box (VelocityRows), which holds every stencil of the particles that scattered.
+  template <class Rows>
+  void pack_velocities(Rows& rows_out, const Grid<Dim>& g, const Vec<Dim>* v,
+                       const Vec<Dim>* v_old) {
+    rows_out.resize(g.size());
+    const long rows = g.active_rows();
+#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
+    for (long r = 0; r < rows; ++r) {
+      const auto [first, count] = g.active_row(r);
+      rows_out.pack(first, count, v, v_old);
     }
   }
 
@@ -377,8 +418,8 @@ class Solver final : public Stepper<Dim> {
         form.alpha.template segment<Dim>(ScatterForm<Dim>::f) +=
             P.m[p] * s.body_force(P, p, s.time);
       }
-      TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(st, g.geo, form, m, mom,
-                                                                           f);
+      TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(st, g.geo, form,
+                                                                           sums_.data());
     } else if (!kBodyForce || !s.body_force) {
       st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
         policy.scatter(src, w, grad, d, m[node], mom[node], f[node]);
@@ -408,7 +449,7 @@ class Solver final : public Stepper<Dim> {
     if (s.body_force)
       form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
     TensorTransfer<Dim, Kernel>::template scatter<TensorTerms{.gradient = true}>(
-        StencilT(P.x[p], g.geo), g.geo, form, g.m.data(), g.p.data(), g.f.data());
+        StencilT(P.x[p], g.geo), g.geo, form, sums_.data());
   }
 
   // v_old <- sum_j c_j Q^j v_old, c = the policy's old_velocity_series(), with
@@ -431,10 +472,11 @@ class Solver final : public Stepper<Dim> {
       g.v_old[i] *= c[0];
     });
     for (std::size_t j = 1; j < c.size(); ++j) {
+      pack_velocities(v_rows_, g, q_field_.data(), nullptr);
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
       for (long p = 0; p < n; ++p) {
         q_particle_[p] = TensorTransfer<Dim, Kernel>::template gather<TensorTerms{}>(
-                             StencilT(P.x[p], g.geo), g.geo, q_field_.data(), nullptr)
+                             StencilT(P.x[p], g.geo), g.geo, v_rows_.data())
                              .v;
       }
       const bool with_mass = j == 1;  // the nodal masses of S+ do not change within the step
@@ -476,6 +518,19 @@ class Solver final : public Stepper<Dim> {
   std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
   std::vector<Vec<Dim>> p_kept_;
   std::vector<Mat<Dim>> tauV_;  // V0_p tau_p, from the materials
+  NodeSums<Dim> sums_;          // the fast path's P2G accumulator
+  bool sums_kept_ = false;      // sums_ holds scatter_momentum's sums (see clear_active_box)
+  // The fast path's G2P input: v (and v_old if the policy reads it) for the
+  // transfer's gather, v alone for the gradient-based F update and XPIC's filter.
+  static constexpr bool kGatherOld = [] {
+    if constexpr (kTensorPath) {
+      return Policy::gather_terms.old;
+    } else {
+      return false;
+    }
+  }();
+  VelocityRows<Dim, kGatherOld> rows_;
+  VelocityRows<Dim, false> v_rows_;
   // P2G colouring: blocks over the first two axes (one in 1D), 2^axes colours.
   static constexpr int kColouredAxes = Dim >= 2 ? 2 : 1;
   static constexpr int kColours = 1 << kColouredAxes;

@@ -15,8 +15,11 @@
 // not redeclaring it, falls back to its own per-node math.
 #pragma once
 
+#include <algorithm>
 #include <type_traits>
+#include <vector>
 
+#include "core/pack.hpp"
 #include "core/stencil.hpp"
 #include "core/types.hpp"
 
@@ -33,7 +36,7 @@ struct TensorTerms {
 //   w_ip alpha + sum_a gamma[a] w_ip (x_i - x_p)_a + sum_a beta[a] grad_a w_ip.
 template <int Dim>
 struct ScatterForm {
-  static constexpr int N = 2 * Dim + 2;  // even, so that it packs into SIMD registers
+  static constexpr int N = Dim == 1 ? 4 : 8;  // whole SIMD registers (core/pack.hpp)
   using Col = Eigen::Matrix<Real, N, 1>;
   Col alpha = Col::Zero();
   Col gamma[Dim];
@@ -43,6 +46,68 @@ struct ScatterForm {
   }
   // Slots of the stacked column.
   static constexpr int m = 0, p = 1, f = 1 + Dim;
+};
+
+// P2G's accumulator: for every grid node the stacked column (m_i, p_i, f_i,
+// padding) of ScatterForm, its N values side by side. A node's update is then a
+// few contiguous SIMD adds instead of scalar adds to three arrays; the solver
+// unpacks the sums into the grid's fields once per step, over the active box.
+template <int Dim>
+struct NodeSums {
+  static constexpr int N = ScatterForm<Dim>::N;
+  using Form = ScatterForm<Dim>;
+  std::vector<Real> values;  // N per node, node-major
+
+  // Zeroes every sum of a grid of `nodes` nodes.
+  void reset(std::size_t nodes) { values.assign(nodes * N, Real(0)); }
+  Real* data() { return values.data(); }
+  // Zeroes `count` consecutive nodes from `first`.
+  void clear(long first, long count) {
+    std::fill_n(values.begin() + first * N, count * N, Real(0));
+  }
+  // m_i, p_i, f_i <- the sums of `count` consecutive nodes from `first` (only f_i
+  // when kMomentum is false: the sums then hold forces only), and, when kDrain,
+  // zero those sums, so that they are zero again for the next scatter.
+  template <bool kMomentum, bool kDrain>
+  void unpack(long first, long count, Real* m, Vec<Dim>* p, Vec<Dim>* f) {
+    for (long i = first; i < first + count; ++i) {
+      Real* s = &values[i * N];
+      if constexpr (kMomentum) m[i] = s[Form::m];
+      for (int a = 0; a < Dim; ++a) {
+        if constexpr (kMomentum) p[i][a] = s[Form::p + a];
+        f[i][a] = s[Form::f + a];
+      }
+      if constexpr (kDrain) std::fill_n(s, N, Real(0));
+    }
+  }
+};
+
+// G2P's input: for every grid node v_i (and, for the transfers that read it,
+// v_i_old) padded to whole SIMD registers (core/pack.hpp), side by side, so
+// that a node's contribution to every sum is a few SIMD operations. The solver
+// packs the grid's velocities once per gather, over the active box.
+template <int Dim, bool kOld>
+struct VelocityRows {
+  static constexpr int width = Dim == 3 ? 4 : Dim;                       // v_i and its padding
+  static constexpr int min_reals = 16 / static_cast<int>(sizeof(Real));  // one SSE register
+  static constexpr int N = std::max((kOld ? 2 : 1) * width, min_reals);
+  static constexpr int old = width;  // slot of v_old
+  std::vector<Real> values;          // N per node, node-major
+
+  void resize(std::size_t nodes) {
+    if (values.size() != nodes * N) values.assign(nodes * N, Real(0));
+  }
+  const Real* data() const { return values.data(); }
+  // Packs `count` consecutive nodes from `first` (v_old is read only when kOld).
+  void pack(long first, long count, const Vec<Dim>* v, const Vec<Dim>* v_old) {
+    for (long i = first; i < first + count; ++i) {
+      Real* r = &values[i * N];
+      for (int a = 0; a < Dim; ++a) {
+        r[a] = v[i][a];
+        if constexpr (kOld) r[old + a] = v_old[i][a];
+      }
+    }
+  }
 };
 
 // G2P sums over the stencil: v = sum w v_i, B = sum w v_i (x_i - x_p)^T,
@@ -73,31 +138,47 @@ class TensorTransfer {
   static constexpr int S = St::S;
 
  public:
-  // Adds the form to the stencil's nodes: m[i], p[i], f[i].
+  // Adds the form to the stencil's nodes of `sums` (NodeSums: N values per node).
   template <TensorTerms T>
   static void scatter(const St& st, const GridGeometry<Dim>& g, const ScatterForm<Dim>& form,
-                      Real* m, Vec<Dim>* p, Vec<Dim>* f) {
+                      Real* __restrict sums) {
     Real wd[Dim][S];
     for (int a = 0; a < Dim; ++a)
       for (int k = 0; k < S; ++k) wd[a][k] = st.w[a][k] * st.d[a][k];
-    scatter_axis<0, T>(st, wd, g.strides(), st.base_node, form.alpha, form.gamma, form.beta, m, p,
-                       f);
+    P gamma[Dim], beta[Dim];
+    for (int a = 0; a < Dim; ++a) {
+      if constexpr (T.moment) gamma[a] = P::gather(form.gamma[a].data());
+      if constexpr (T.gradient) beta[a] = P::gather(form.beta[a].data());
+    }
+    scatter_axis<0, T>(st, wd, g.strides(), st.base_node, P::gather(form.alpha.data()), gamma, beta,
+                       sums);
   }
 
+  // The sums from the packed velocities (VelocityRows<Dim, T.old>::data()).
   template <TensorTerms T>
-  static GatherSums<Dim> gather(const St& st, const GridGeometry<Dim>& g, const Vec<Dim>* v,
-                                const Vec<Dim>* v_old) {
+  static GatherSums<Dim> gather(const St& st, const GridGeometry<Dim>& g,
+                                const Real* __restrict rows) {
     Real wd[Dim][S];
     for (int a = 0; a < Dim; ++a)
       for (int k = 0; k < S; ++k) wd[a][k] = st.w[a][k] * st.d[a][k];
-    Partial part;
-    gather_axis<0, T>(st, wd, g.strides(), st.base_node, v, v_old, part);
+    Partial<T> part;
+    gather_axis<0, T>(st, wd, g.strides(), st.base_node, rows, part);
     GatherSums<Dim> out;
-    out.v = part.W;
-    if constexpr (T.old) out.v_old = part.W_old;
+    Real sum[VR<T>::N];
+    part.W.store(sum);
     for (int a = 0; a < Dim; ++a) {
-      if constexpr (T.moment) out.B.col(a) = part.Dm[a];
-      if constexpr (T.gradient) out.G.col(a) = part.Gr[a];
+      out.v[a] = sum[a];
+      if constexpr (T.old) out.v_old[a] = sum[VR<T>::old + a];
+    }
+    for (int a = 0; a < Dim; ++a) {
+      if constexpr (T.moment) {
+        part.Dm[a].store(sum);
+        for (int b = 0; b < Dim; ++b) out.B(b, a) = sum[b];
+      }
+      if constexpr (T.gradient) {
+        part.Gr[a].store(sum);
+        for (int b = 0; b < Dim; ++b) out.G(b, a) = sum[b];
+      }
     }
     if constexpr (kernel_particle_inertia<Kernel>) out.D_inv = st.inertia_diagonal().cwiseInverse();
     return out;
@@ -107,68 +188,78 @@ class TensorTransfer {
   using Col = typename ScatterForm<Dim>::Col;
   using V = Vec<Dim>;
 
+  static constexpr int N = ScatterForm<Dim>::N;
+
+  using P = Row<N>;
+
   // Top down: on entry to axis A, the node value is
   //   alpha prod_{b>=A} w_b + sum_{a>=A} gamma[a] (prod_{b>=A} w_b) d_a
   //                         + sum_{a>=A} beta[a] dw_a prod_{b>=A, b!=a} w_b.
   template <int A, TensorTerms T>
-  static void scatter_axis(const St& st, const Real (&wd)[Dim][S],
-                           const std::array<long, Dim>& stride, long node, const Col& alpha,
-                           const Col* gamma, const Col* beta, Real* m, V* p, V* f) {
+  [[gnu::always_inline]] static inline void scatter_axis(
+      const St& st, const Real (&wd)[Dim][S], const std::array<long, Dim>& stride, long node,
+      const P& alpha, const P (&gamma)[Dim], const P (&beta)[Dim], Real* __restrict sums) {
     for (int k = 0; k < S; ++k) {
       const Real w = st.w[A][k];
-      Col al = w * alpha;
-      if constexpr (T.moment) al += wd[A][k] * gamma[A];
-      if constexpr (T.gradient) al += st.dw[A][k] * beta[A];
+      P al = w * alpha;
+      if constexpr (T.moment) al.add_scaled(wd[A][k], gamma[A]);
+      if constexpr (T.gradient) al.add_scaled(st.dw[A][k], beta[A]);
       const long n = node + k * stride[A];
       if constexpr (A == Dim - 1) {
-        m[n] += al[ScatterForm<Dim>::m];
-        p[n] += al.template segment<Dim>(ScatterForm<Dim>::p);
-        f[n] += al.template segment<Dim>(ScatterForm<Dim>::f);
+        Real* out = sums + n * N;
+        P sum = P::load(out);
+        sum += al;
+        sum.store(out);
       } else {
-        Col g2[Dim], b2[Dim];
+        P g2[Dim], b2[Dim];
         for (int a = A + 1; a < Dim; ++a) {
           if constexpr (T.moment) g2[a] = w * gamma[a];
           if constexpr (T.gradient) b2[a] = w * beta[a];
         }
-        scatter_axis<A + 1, T>(st, wd, stride, n, al, g2, b2, m, p, f);
+        scatter_axis<A + 1, T>(st, wd, stride, n, al, g2, b2, sums);
       }
     }
   }
 
-  // Bottom up: the sums over the sub-stencil of axes A..Dim-1.
+  // Bottom up: the sums over the sub-stencil of axes A..Dim-1, of whole rows
+  // (v_i and v_i_old together).
+  template <TensorTerms T>
+  using VR = VelocityRows<Dim, T.old>;
+  template <TensorTerms T>
   struct Partial {
-    V W, W_old;
-    V Dm[Dim], Gr[Dim];
+    using GR = Row<VR<T>::N>;
+    GR W;
+    GR Dm[Dim], Gr[Dim];
   };
   template <int A, TensorTerms T>
-  static void gather_axis(const St& st, const Real (&wd)[Dim][S],
-                          const std::array<long, Dim>& stride, long node, const V* v,
-                          const V* v_old, Partial& out) {
-    out.W.setZero();
-    if constexpr (T.old) out.W_old.setZero();
+  [[gnu::always_inline]] static inline void gather_axis(const St& st, const Real (&wd)[Dim][S],
+                                                        const std::array<long, Dim>& stride,
+                                                        long node, const Real* __restrict rows,
+                                                        Partial<T>& out) {
+    using GR = typename Partial<T>::GR;
+    constexpr int N = VR<T>::N;
+    out.W = GR::zero();
     for (int a = A; a < Dim; ++a) {
-      if constexpr (T.moment) out.Dm[a].setZero();
-      if constexpr (T.gradient) out.Gr[a].setZero();
+      if constexpr (T.moment) out.Dm[a] = GR::zero();
+      if constexpr (T.gradient) out.Gr[a] = GR::zero();
     }
     for (int k = 0; k < S; ++k) {
       const Real w = st.w[A][k];
       const long n = node + k * stride[A];
       if constexpr (A == Dim - 1) {
-        const V& u = v[n];
-        out.W += w * u;
-        if constexpr (T.old) out.W_old += w * v_old[n];
-        if constexpr (T.moment) out.Dm[A] += wd[A][k] * u;
-        if constexpr (T.gradient) out.Gr[A] += st.dw[A][k] * u;
+        const GR u = GR::load(rows + n * N);
+        out.W.add_scaled(w, u);
+        if constexpr (T.moment) out.Dm[A].add_scaled(wd[A][k], u);
+        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw[A][k], u);
       } else {
-        Partial sub;
-        gather_axis<A + 1, T>(st, wd, stride, n, v, v_old, sub);
-        out.W += w * sub.W;
-        if constexpr (T.old) out.W_old += w * sub.W_old;
-        if constexpr (T.moment) out.Dm[A] += wd[A][k] * sub.W;
-        if constexpr (T.gradient) out.Gr[A] += st.dw[A][k] * sub.W;
+        Partial<T> sub;
+        gather_axis<A + 1, T>(st, wd, stride, n, rows, sub);
+        out.W.add_scaled(w, sub.W);
+        if constexpr (T.moment) out.Dm[A].add_scaled(wd[A][k], sub.W);
+        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw[A][k], sub.W);
         for (int a = A + 1; a < Dim; ++a) {
-          if constexpr (T.moment) out.Dm[a] += w * sub.Dm[a];
-          if constexpr (T.gradient) out.Gr[a] += w * sub.Gr[a];
+          if constexpr (T.moment) out.Dm[a].add_scaled(w, sub.Dm[a]);
+          if constexpr (T.gradient) out.Gr[a].add_scaled(w, sub.Gr[a]);
         }
       }
     }

@@ -184,8 +184,11 @@ void CheckAffineRecovery(Real l) {
     st.for_each_node(g, [&](long n, Real w, const Vec<2>& grad, const Vec<2>& d) {
       policy.gather(slow, w, grad, d, v[n], v[n]);
     });
+    VelocityRows<2, Policy::gather_terms.old> rows;
+    rows.resize(v.size());
+    rows.pack(0, static_cast<long>(v.size()), v.data(), v.data());
     const auto fast = policy.gather_from(
-        TensorTransfer<2, K>::template gather<Policy::gather_terms>(st, g, v.data(), v.data()));
+        TensorTransfer<2, K>::template gather<Policy::gather_terms>(st, g, rows.data()));
     EXPECT_LT((slow.C - A).norm(), 1e-11) << "l=" << l << " x_p=" << xp.transpose();
     EXPECT_LT((fast.C - A).norm(), 1e-11) << "l=" << l << " x_p=" << xp.transpose();
     EXPECT_LT((slow.v - (b + A * xp)).norm(), 1e-12);

@@ -79,8 +79,12 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       });
       ScatterForm<Dim> form;
       policy.scatter_form(src, form);
-      TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(
-          st, geo, form, fast.m.data(), fast.p.data(), fast.f.data());
+      NodeSums<Dim> sums;
+      sums.reset(fast.size());
+      TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(st, geo, form,
+                                                                           sums.data());
+      sums.template unpack<true, true>(0, static_cast<long>(fast.size()), fast.m.data(),
+                                       fast.p.data(), fast.f.data());
       EXPECT_LT(relative_gap(ref.m, fast.m), 1e-14) << what << " m_i";
       EXPECT_LT(relative_gap(ref.p, fast.p), 1e-14) << what << " p_i";
       EXPECT_LT(relative_gap(ref.f, fast.f), 1e-14) << what << " f_i";
@@ -94,9 +98,11 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       st.for_each_node(geo, [&](long n, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
         policy.gather(g_ref, w, grad, d, ref.v[n], ref.v_old[n]);
       });
-      const auto g_fast =
-          policy.gather_from(TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(
-              st, geo, ref.v.data(), ref.v_old.data()));
+      VelocityRows<Dim, Policy::gather_terms.old> rows;
+      rows.resize(ref.size());
+      rows.pack(0, static_cast<long>(ref.size()), ref.v.data(), ref.v_old.data());
+      const auto g_fast = policy.gather_from(
+          TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(st, geo, rows.data()));
       Particles<Dim> Pr = P, Pf = P;
       policy.finish(g_ref, Pr, 0, 1e-2);
       policy.finish(g_fast, Pf, 0, 1e-2);
