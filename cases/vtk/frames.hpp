@@ -32,7 +32,7 @@ namespace mpmtb {
 template <int Dim>
 double von_mises(const Mat<Dim>& sigma) {
   Eigen::Matrix3d s = Eigen::Matrix3d::Zero();
-  s.template topLeftCorner<Dim, Dim>() = sigma;
+  s.template topLeftCorner<Dim, Dim>() = sigma.template cast<double>();
   s -= s.trace() / 3 * Eigen::Matrix3d::Identity();
   return std::sqrt(1.5 * s.squaredNorm());
 }
@@ -83,7 +83,8 @@ vtk::PointCloud particle_cloud(const State<Dim>& s) {
     }
   }
   c.point_data.push_back(vtk::DataArray::float64("velocity", v, 3));
-  c.point_data.push_back(vtk::DataArray::float64("mass", P.m));
+  c.point_data.push_back(
+      vtk::DataArray::float64("mass", std::vector<double>(P.m.begin(), P.m.end())));
   c.point_data.push_back(vtk::DataArray::float64("volume", vol));
   c.point_data.push_back(vtk::DataArray::float64("J", J));
   c.point_data.push_back(vtk::DataArray::float64("von_mises", vm));

@@ -3,6 +3,7 @@
 // Included only by the transfers' own .cpp files, which instantiate it.
 #pragma once
 
+#include <omp.h>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -377,26 +378,71 @@ class Solver final : public Stepper<Dim> {
       }
       block_of_[p] = colour * per_colour + index;
     }
-    for (long p = 0; p < n; ++p) ++block_start_[block_of_[p] + 1];
-    for (std::size_t k = 1; k < block_start_.size(); ++k) block_start_[k] += block_start_[k - 1];
+    sort_into_blocks(n);
+  }
+
+  // block_order_: the particle ids by block_of_, stable (index order within a
+  // block), and block_start_: where each block starts in it. A counting sort in
+  // parallel: each thread counts, then places, its own run of ids, and the runs
+  // of the threads follow each other in every block, so the order is the serial one.
+  void sort_into_blocks(long n) {
+    const std::size_t blocks = block_start_.size() - 1;
     block_order_.resize(n);
-    fill_.assign(block_start_.begin(), block_start_.end() - 1);
-    for (long p = 0; p < n; ++p) block_order_[fill_[block_of_[p]]++] = static_cast<int>(p);
+#pragma omp parallel if (n >= kParallelMinimum)
+    {
+      const long threads = omp_get_num_threads(), t = omp_get_thread_num();
+#pragma omp single
+      fill_.assign(threads * blocks, 0);  // then the implicit barrier
+      int* mine = &fill_[t * blocks];
+      const long from = n * t / threads, to = n * (t + 1) / threads;
+      for (long p = from; p < to; ++p) ++mine[block_of_[p]];
+#pragma omp barrier
+#pragma omp single
+      {
+        int start = 0;
+        for (std::size_t b = 0; b < blocks; ++b) {
+          block_start_[b] = start;
+          for (long u = 0; u < threads; ++u) {
+            const int c = fill_[u * blocks + b];
+            fill_[u * blocks + b] = start;
+            start += c;
+          }
+        }
+        block_start_[blocks] = start;
+      }
+      for (long p = from; p < to; ++p) block_order_[mine[block_of_[p]]++] = static_cast<int>(p);
+    }
   }
 
   // Blocks of Kernel::support cells along the first two axes: the stencils of
   // blocks two apart never overlap, so the blocks of one colour (the parity of
   // their block coordinates) scatter in parallel, one colour after the other.
   // No locks, and the summation order (and so the result) does not depend on
-  // the thread count.
+  // the thread count. Each thread takes a run of consecutive blocks holding its
+  // share of the colour's particles: balanced, and the same region of space in
+  // every colour and step, so that the particles a thread scatters are mostly
+  // those it gathers (G2P splits the particles in index order, which follows
+  // space: the lattice order of the setup) and stay in its core's caches.
   template <class Scatter>
   void for_each_particle_coloured(const State<Dim>& s, Scatter&& scatter) {
     const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
     const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
-    for (int colour = 0; colour < kColours; ++colour) {
-#pragma omp parallel for schedule(dynamic, 1) if (parallel)
-      for (int b = colour * per_colour; b < (colour + 1) * per_colour; ++b) {
-        for (int k = block_start_[b]; k < block_start_[b + 1]; ++k) scatter(block_order_[k]);
+#pragma omp parallel if (parallel)
+    {
+      const long threads = omp_get_num_threads(), t = omp_get_thread_num();
+      for (int colour = 0; colour < kColours; ++colour) {
+        const auto first = block_start_.begin() + colour * per_colour;
+        const auto last = first + per_colour;
+        const long count = *last - *first;
+        // The first block at or after the thread's share of the particles.
+        const auto share = [&](long k) {
+          return k == threads ? last : std::lower_bound(first, last, *first + count * k / threads);
+        };
+        const auto from = share(t), to = share(t + 1);
+        for (auto b = from; b != to; ++b) {
+          for (int k = *b; k < *(b + 1); ++k) scatter(block_order_[k]);
+        }
+#pragma omp barrier
       }
     }
   }
