@@ -172,6 +172,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   Parameters transfer_params = scene.transfer_params;
   auto stepper = make_stepper<Dim>(scene.transfer, scene.kernel, transfer_params);
   stepper->set_update_order(scene.update_order);
+  stepper->prepare(s);  // one-time allocations, outside the timed steps
   auto reference = make_reference<Dim>(scene);
   if (reference) reference->initialize(s);
 

@@ -48,6 +48,12 @@ class Solver final : public Stepper<Dim> {
   std::string_view kernel_name() const override { return Kernel::name; }
   bool gradient_based() const override { return transfer_is_gradient_based<Transfer>(); }
 
+  void prepare(const State<Dim>& s) override {
+    if (sums_.values.size() != s.grid.size() * NodeSums<Dim>::N) sums_.reset(s.grid.size());
+    if constexpr (kTensorPath) rows_.resize(s.grid.size());
+    v_rows_.resize(s.grid.size());
+  }
+
   void particles_to_grid(State<Dim>& s, Real dt) override {
     (void)dt;  // forces are kept apart from momentum; the grid update integrates them
     compute_stresses(s);

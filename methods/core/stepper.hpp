@@ -114,6 +114,11 @@ class Stepper {
     return r;
   }
 
+  // Allocates the step's per-grid buffers for this state's grid, as the grid's
+  // own fields are allocated with it: a step's cost then follows the particles
+  // and the active region, not the domain. Optional (the first step allocates).
+  virtual void prepare(const State<Dim>& /*s*/) {}
+
   // The stages, public so that tests can check each transfer direction.
   // P2G: momentum and force together (usl, musl).
   virtual void particles_to_grid(State<Dim>& s, Real dt) = 0;
