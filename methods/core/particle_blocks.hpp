@@ -1,0 +1,153 @@
+// P2G's block colouring: the particles binned into blocks of Kernel::support
+// cells along the first two axes, in 2^axes colours, so that the blocks of one
+// colour scatter in parallel without locks (Solver, core/solver_impl.hpp).
+#pragma once
+
+#include <omp.h>
+#include <algorithm>
+#include <array>
+#include <limits>
+#include <vector>
+
+#include "core/state.hpp"
+#include "core/stencil.hpp"
+
+namespace mpmtb {
+
+template <int Dim, class Kernel>
+class ParticleBlocks {
+  using StencilT = Stencil<Dim, Kernel>;
+
+ public:
+  // Sets the grid's active box to the nodes the particles' stencils reach, plus
+  // GridGeometry::pad layers (the mirrors of the wall ghosts), and sorts the
+  // particle ids by colour, then block (a stable counting sort: particle order
+  // within a block).
+  void bin(State<Dim>& s) {
+    Grid<Dim>& g = s.grid;
+    const auto& geo = g.geo;
+    constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
+    const auto& x = s.particles.x;
+    const long n = static_cast<long>(x.size());
+    const Real inv_dx = 1 / geo.dx;
+    int lo[Dim], hi[Dim];
+    std::fill_n(lo, Dim, std::numeric_limits<int>::max());
+    std::fill_n(hi, Dim, std::numeric_limits<int>::min());
+    first_.resize(n);
+    // Min and max are exact, so the box does not depend on the thread count.
+#pragma omp parallel for schedule(static) reduction(min         \
+                                                    : lo[:Dim]) \
+    reduction(max                                               \
+              : hi[:Dim]) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      for (int a = 0; a < Dim; ++a) {
+        // As in Stencil, clamped so that a stray particle cannot index out of range.
+        const Real xi =
+            std::clamp((x[p][a] - geo.lo[a]) * inv_dx, Real(-pad), Real(geo.cells[a] + pad));
+        const int f = StencilT::first_index(xi) + pad;
+        lo[a] = std::min(lo[a], f);
+        hi[a] = std::max(hi[a], f);
+        if (a < kColouredAxes) first_[p][a] = f;
+      }
+    }
+    for (int a = 0; a < Dim; ++a) {
+      g.active_lo[a] = n ? std::max(0, lo[a] - pad) : 0;
+      g.active_hi[a] = n ? std::min(geo.nodes(a) - 1, hi[a] + S - 1 + pad) : -1;
+    }
+    // Blocks of S cells from the lowest first node, half of them per colour and axis.
+    std::array<int, kColouredAxes> half{};
+    int per_colour = 1;
+    for (int a = 0; a < kColouredAxes; ++a) {
+      half[a] = n ? ((hi[a] - lo[a]) / S + 2) / 2 : 1;
+      per_colour *= half[a];
+    }
+    block_of_.resize(n);
+    block_start_.assign(kColours * per_colour + 1, 0);
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      int colour = 0, index = 0;
+      for (int a = 0; a < kColouredAxes; ++a) {
+        const int b = (first_[p][a] - lo[a]) / S;
+        colour |= (b & 1) << a;
+        index = index * half[a] + b / 2;
+      }
+      block_of_[p] = colour * per_colour + index;
+    }
+    sort_into_blocks(n);
+  }
+
+  // block_order_: the particle ids by block_of_, stable (index order within a
+  // block), and block_start_: where each block starts in it. A counting sort in
+  // parallel: each thread counts, then places, its own run of ids, and the runs
+  // of the threads follow each other in every block, so the order is the serial one.
+  void sort_into_blocks(long n) {
+    const std::size_t blocks = block_start_.size() - 1;
+    block_order_.resize(n);
+#pragma omp parallel if (n >= kParallelMinimum)
+    {
+      const long threads = omp_get_num_threads(), t = omp_get_thread_num();
+#pragma omp single
+      fill_.assign(threads * blocks, 0);  // then the implicit barrier
+      int* mine = &fill_[t * blocks];
+      const long from = n * t / threads, to = n * (t + 1) / threads;
+      for (long p = from; p < to; ++p) ++mine[block_of_[p]];
+#pragma omp barrier
+#pragma omp single
+      {
+        int start = 0;
+        for (std::size_t b = 0; b < blocks; ++b) {
+          block_start_[b] = start;
+          for (long u = 0; u < threads; ++u) {
+            const int c = fill_[u * blocks + b];
+            fill_[u * blocks + b] = start;
+            start += c;
+          }
+        }
+        block_start_[blocks] = start;
+      }
+      for (long p = from; p < to; ++p) block_order_[mine[block_of_[p]]++] = static_cast<int>(p);
+    }
+  }
+
+  // Blocks of Kernel::support cells along the first two axes: the stencils of
+  // blocks two apart never overlap, so the blocks of one colour (the parity of
+  // their block coordinates) scatter in parallel, one colour after the other.
+  // No locks, and the summation order (and so the result) does not depend on
+  // the thread count. Each thread takes a run of consecutive blocks holding its
+  // share of the colour's particles: balanced, and the same region of space in
+  // every colour and step, so that the particles a thread scatters are mostly
+  // those it gathers (G2P splits the particles in index order, which follows
+  // space: the lattice order of the setup) and stay in its core's caches.
+  template <class Scatter>
+  void for_each_coloured(const State<Dim>& s, Scatter&& scatter) const {
+    const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
+    const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
+#pragma omp parallel if (parallel)
+    {
+      const long threads = omp_get_num_threads(), t = omp_get_thread_num();
+      for (int colour = 0; colour < kColours; ++colour) {
+        const auto first = block_start_.begin() + colour * per_colour;
+        const auto last = first + per_colour;
+        const long count = *last - *first;
+        // The first block at or after the thread's share of the particles.
+        const auto share = [&](long k) {
+          return k == threads ? last : std::lower_bound(first, last, *first + count * k / threads);
+        };
+        const auto from = share(t), to = share(t + 1);
+        for (auto b = from; b != to; ++b) {
+          for (int k = *b; k < *(b + 1); ++k) scatter(block_order_[k]);
+        }
+#pragma omp barrier
+      }
+    }
+  }
+
+ private:
+  // Blocks over the first two axes (one in 1D), 2^axes colours.
+  static constexpr int kColouredAxes = Dim >= 2 ? 2 : 1;
+  static constexpr int kColours = 1 << kColouredAxes;
+  std::vector<std::array<int, kColouredAxes>> first_;  // first stencil node per coloured axis
+  std::vector<int> block_of_, block_start_, block_order_, fill_;
+};
+
+}  // namespace mpmtb
