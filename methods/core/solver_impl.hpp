@@ -3,7 +3,6 @@
 // Included only by the transfers' own .cpp files, which instantiate it.
 #pragma once
 
-#include <omp.h>
 #include <algorithm>
 #include <array>
 #include <cmath>
@@ -50,7 +49,7 @@ class Solver final : public Stepper<Dim> {
   bool gradient_based() const override { return transfer_is_gradient_based<Transfer>(); }
 
   void prepare(const State<Dim>& s) override {
-    if (sums_.values.size() != s.grid.size() * NodeSums<Dim>::N) sums_.reset(s.grid.size());
+    sums_.resize(s.grid.size());
     if constexpr (kTensorPath) rows_.resize(s.grid.size());
     v_rows_.resize(s.grid.size());
   }
@@ -71,11 +70,7 @@ class Solver final : public Stepper<Dim> {
     const long rows = g.active_rows();
     const bool parallel = g.active_nodes() >= kParallelMinimum;
     const Vec<Dim> gravity = s.gravity;
-#pragma omp parallel for schedule(static) if (parallel)
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
-      for (long i = first; i < first + count; ++i) g.f[i] += g.m[i] * gravity;
-    }
+    for_each_active_node(g, [&](long i) { g.f[i] += g.m[i] * gravity; });
     s.walls.fold(g);
     Real rx = 0, ry = 0, rz = 0;  // reaction of the pinned nodes
 #pragma omp parallel for schedule(static) reduction(+ : rx, ry, rz) if (parallel)
@@ -216,37 +211,30 @@ class Solver final : public Stepper<Dim> {
   // exchanged with the boundaries here, so none is recorded.
   void grid_velocities(State<Dim>& s, Real t) override {
     Grid<Dim>& g = s.grid;
-    const long rows = g.active_rows();
     m_kept_.resize(g.m.size());
     p_kept_.resize(g.p.size());
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
+    for_each_active_row(g, [&](long first, long count) {
       std::copy_n(g.m.begin() + first, count, m_kept_.begin() + first);
       std::copy_n(g.p.begin() + first, count, p_kept_.begin() + first);
-    }
+    });
     s.walls.fold(g);
-#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
-      for (long i = first; i < first + count; ++i) {
-        if (g.m[i] > 0 && !g.pinned[i]) {
-          g.v[i] = g.p[i] / g.m[i];
-        } else {
-          g.v[i].setZero();
-        }
+    for_each_active_node(g, [&](long i) {
+      if (g.m[i] > 0 && !g.pinned[i]) {
+        g.v[i] = g.p[i] / g.m[i];
+      } else {
+        g.v[i].setZero();
       }
-    }
+    });
     s.walls.apply(g);
     if (!s.colliders.empty()) {
       Vec3 impulse = Vec3::Zero();
       Real work = 0;
       s.colliders.apply(g, t, impulse, work);
     }
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
+    for_each_active_row(g, [&](long first, long count) {
       std::copy_n(m_kept_.begin() + first, count, g.m.begin() + first);
       std::copy_n(p_kept_.begin() + first, count, g.p.begin() + first);
-    }
+    });
   }
 
   // F_p <- (I + dt sum_i v_i grad w_ip^T) F_p, the F update of every
@@ -290,12 +278,9 @@ class Solver final : public Stepper<Dim> {
   // The scatter's sums are zero outside the calls that fill and drain them, but
   // for those that scatter_momentum kept and no scatter_forces drained (musl).
   void clear_active_box(Grid<Dim>& g) {
-    if (sums_.values.size() != g.size() * NodeSums<Dim>::N) sums_.reset(g.size());
+    sums_.resize(g.size());
     const bool clear_sums = std::exchange(sums_kept_, false);
-    const long rows = g.active_rows();
-#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
+    for_each_active_row(g, [&](long first, long count) {
       std::fill_n(g.m.begin() + first, count, Real(0));
       std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
       std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
@@ -303,18 +288,15 @@ class Solver final : public Stepper<Dim> {
       std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
       std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
       if (clear_sums) sums_.clear(first, count);
-    }
+    });
   }
 
   // m_i, p_i, f_i <- the scatter's sums over the active box (NodeSums::unpack).
   template <bool kMomentum, bool kDrain>
   void unpack_sums(Grid<Dim>& g) {
-    const long rows = g.active_rows();
-#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
+    for_each_active_row(g, [&](long first, long count) {
       sums_.template unpack<kMomentum, kDrain>(first, count, g.m.data(), g.p.data(), g.f.data());
-    }
+    });
   }
 
   // The gathers' input: v and v_old (if the rows hold it) packed over the active
@@ -323,12 +305,7 @@ class Solver final : public Stepper<Dim> {
   void pack_velocities(Rows& rows_out, const Grid<Dim>& g, const Vec<Dim>* v,
                        const Vec<Dim>* v_old) {
     rows_out.resize(g.size());
-    const long rows = g.active_rows();
-#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
-      rows_out.pack(first, count, v, v_old);
-    }
+    for_each_active_row(g, [&](long first, long count) { rows_out.pack(first, count, v, v_old); });
   }
 
   // kBodyForce = false: the momentum part only (tauV_ is zero then).
@@ -433,15 +410,23 @@ class Solver final : public Stepper<Dim> {
     }
   }
 
-  // f(node) for every node of the active box, in parallel over its rows.
+  // f(first, count) for every row of the active box (runs of consecutive nodes
+  // along the last axis), in parallel.
   template <class F>
-  static void for_each_active_node(const Grid<Dim>& g, F&& f) {
+  static void for_each_active_row(const Grid<Dim>& g, F&& f) {
     const long rows = g.active_rows();
 #pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
     for (long r = 0; r < rows; ++r) {
       const auto [first, count] = g.active_row(r);
-      for (long i = first; i < first + count; ++i) f(i);
+      f(first, static_cast<long>(count));
     }
+  }
+  // f(node) for every node of the active box, in parallel over its rows.
+  template <class F>
+  static void for_each_active_node(const Grid<Dim>& g, F&& f) {
+    for_each_active_row(g, [&](long first, long count) {
+      for (long i = first; i < first + count; ++i) f(i);
+    });
   }
 
   Parameters transfer_params_;

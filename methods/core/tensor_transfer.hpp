@@ -58,8 +58,10 @@ struct NodeSums {
   using Form = ScatterForm<Dim>;
   std::vector<Real> values;  // N per node, node-major
 
-  // Zeroes every sum of a grid of `nodes` nodes.
-  void reset(std::size_t nodes) { values.assign(nodes * N, Real(0)); }
+  // Sized for a grid of `nodes` nodes, all zero when the size changes.
+  void resize(std::size_t nodes) {
+    if (values.size() != nodes * N) values.assign(nodes * N, Real(0));
+  }
   Real* data() { return values.data(); }
   // Zeroes `count` consecutive nodes from `first`.
   void clear(long first, long count) {

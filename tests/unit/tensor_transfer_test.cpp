@@ -80,7 +80,7 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       ScatterForm<Dim> form;
       policy.scatter_form(src, form);
       NodeSums<Dim> sums;
-      sums.reset(fast.size());
+      sums.resize(fast.size());
       TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(st, geo, form,
                                                                            sums.data());
       sums.template unpack<true, true>(0, static_cast<long>(fast.size()), fast.m.data(),
