@@ -17,6 +17,14 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 
+// The transfers' per-node code is inlined whole; sanitizer builds leave it to
+// the compiler (CMakeLists.txt).
+#ifdef MPMTB_NO_FORCE_INLINE
+#define MPMTB_INLINE
+#else
+#define MPMTB_INLINE [[gnu::always_inline]]
+#endif
+
 namespace mpmtb {
 
 #if defined(__AVX512F__)
@@ -52,23 +60,23 @@ struct Row {
   using Pack = typename PackOf<bytes>::type;
   Pack v[K];
 
-  [[gnu::always_inline]] static Row zero() {
+  MPMTB_INLINE static Row zero() {
     Row r;
     for (int k = 0; k < K; ++k) r.v[k] = Pack{};
     return r;
   }
   // From and to any Real array (unaligned moves: no cost on aligned data).
-  [[gnu::always_inline]] static Row load(const Real* from) {
+  MPMTB_INLINE static Row load(const Real* from) {
     Row r;
     for (int k = 0; k < K; ++k) std::memcpy(&r.v[k], from + k * lanes, bytes);
     return r;
   }
-  [[gnu::always_inline]] void store(Real* to) const {
+  MPMTB_INLINE void store(Real* to) const {
     for (int k = 0; k < K; ++k) std::memcpy(to + k * lanes, &v[k], bytes);
   }
   // From N scalars, in registers: values that were just stored one by one are
   // not read back by a wider load (which would wait for the stores to retire).
-  [[gnu::always_inline]] static Row gather(const Real* from) {
+  MPMTB_INLINE static Row gather(const Real* from) {
     Row r;
     for (int k = 0; k < K; ++k) {
       r.v[k] = [&]<int... i>(std::integer_sequence<int, i...>) {
@@ -78,17 +86,17 @@ struct Row {
     }
     return r;
   }
-  [[gnu::always_inline]] friend Row operator*(Real s, const Row& a) {
+  MPMTB_INLINE friend Row operator*(Real s, const Row& a) {
     Row r;
     for (int k = 0; k < K; ++k) r.v[k] = s * a.v[k];
     return r;
   }
-  [[gnu::always_inline]] Row& operator+=(const Row& a) {
+  MPMTB_INLINE Row& operator+=(const Row& a) {
     for (int k = 0; k < K; ++k) v[k] += a.v[k];
     return *this;
   }
   // *this += s a
-  [[gnu::always_inline]] void add_scaled(Real s, const Row& a) {
+  MPMTB_INLINE void add_scaled(Real s, const Row& a) {
     for (int k = 0; k < K; ++k) v[k] += s * a.v[k];
   }
 };

@@ -5,13 +5,17 @@
 //   Source prepare(P, p, tauV, stencil)   beside, or instead of, Source prepare(P, p, tauV)
 //   Gather begin_gather(stencil)          returning its own Gather type.
 // Policies without them (or whose own Source/Gather types hide a base's) are called
-// as before.
+// as before. On the fast path (core/tensor_transfer.hpp) a policy turns the
+// stencil sums into its Gather with
+//   Gather gather_from(sums)                     or, with TensorTerms::nodal,
+//   void gather_from(sums, Gather&)              after the sums filled Gather::wv.
 #pragma once
 
 #include <concepts>
 
 #include "core/particles.hpp"
 #include "core/stencil.hpp"
+#include "core/tensor_transfer.hpp"
 
 namespace mpmtb {
 
@@ -39,6 +43,22 @@ typename Policy::Gather begin_gather(const Policy& policy, const Stencil<Dim, Ke
     return policy.begin_gather(st);
   } else {
     return {};
+  }
+}
+
+// G2P on the fast path: the policy's Gather from the packed velocity rows
+// (VelocityRows) around the particle.
+template <class Policy, int Dim, class Kernel>
+typename Policy::Gather tensor_gather(const Policy& policy, const Stencil<Dim, Kernel>& st,
+                                      const GridGeometry<Dim>& g, const Real* rows) {
+  constexpr TensorTerms terms = Policy::gather_terms;
+  using Sums = TensorTransfer<Dim, Kernel>;
+  if constexpr (terms.nodal) {
+    typename Policy::Gather gather = begin_gather(policy, st);
+    policy.gather_from(Sums::template gather<terms>(st, g, rows, gather.wv), gather);
+    return gather;
+  } else {
+    return policy.gather_from(Sums::template gather<terms>(st, g, rows));
   }
 }
 

@@ -127,9 +127,7 @@ class Solver final : public Stepper<Dim> {
       const StencilT st(P.x[p], g.geo);
       typename Policy::Gather gather;
       if constexpr (kTensorPath) {
-        gather =
-            policy.gather_from(TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(
-                st, g.geo, rows_.data()));
+        gather = tensor_gather(policy, st, g.geo, rows_.data());  // core/policy_hooks.hpp
       } else {
         gather = begin_gather(policy, st);  // core/policy_hooks.hpp
         st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {

@@ -100,7 +100,7 @@ struct Stencil {
   // compiler when the callback does not read the gradient).
   template <class Fn>
   void for_each_node(const GridGeometry<Dim>& g, Fn&& f) const {
-    Real grad_part[Dim];
+    Real grad_part[Dim] = {};  // (read only for the axes already done)
     Vec<Dim> dpos;
     loop_axis<0>(g.strides(), base_node, Real(1), grad_part, dpos, f);
   }

@@ -30,10 +30,15 @@ struct TensorTerms {
   bool moment = false;    // w_ip (x_i - x_p)
   bool gradient = false;  // grad w_ip
   bool old = false;       // gather only: sum w_ip v_i_old (FLIP)
+  // A field over the stencil's own nodes: P2G adds w_ip u_j to p_i, G2P returns
+  // w_ip v_i node by node (PolyPIC's per-node polynomial velocity).
+  bool nodal = false;
 };
 
 // The P2G contribution to node i, stacked as (m_i, p_i, f_i, padding):
-//   w_ip alpha + sum_a gamma[a] w_ip (x_i - x_p)_a + sum_a beta[a] grad_a w_ip.
+//   w_ip alpha + sum_a gamma[a] w_ip (x_i - x_p)_a + sum_a beta[a] grad_a w_ip
+//   (+ w_ip nodal[j] in p_i with TensorTerms::nodal, j the node's index in the
+//   stencil, last axis fastest).
 template <int Dim>
 struct ScatterForm {
   static constexpr int N = Dim == 1 ? 4 : 8;  // whole SIMD registers (core/pack.hpp)
@@ -41,6 +46,7 @@ struct ScatterForm {
   Col alpha = Col::Zero();
   Col gamma[Dim];
   Col beta[Dim];
+  const Vec<Dim>* nodal = nullptr;  // Kernel::support^Dim values (TensorTerms::nodal)
   ScatterForm() {
     for (int a = 0; a < Dim; ++a) gamma[a].setZero(), beta[a].setZero();
   }
@@ -152,19 +158,28 @@ class TensorTransfer {
       if constexpr (T.moment) gamma[a] = P::gather(form.gamma[a].data());
       if constexpr (T.gradient) beta[a] = P::gather(form.beta[a].data());
     }
+    P nodal[T.nodal ? St::count : 1];
+    if constexpr (T.nodal) {
+      for (int j = 0; j < St::count; ++j) {
+        Real row[N] = {};
+        for (int a = 0; a < Dim; ++a) row[ScatterForm<Dim>::p + a] = form.nodal[j][a];
+        nodal[j] = P::gather(row);
+      }
+    }
     scatter_axis<0, T>(st, wd, g.strides(), st.base_node, P::gather(form.alpha.data()), gamma, beta,
-                       sums);
+                       nodal, 0, Real(1), sums);
   }
 
-  // The sums from the packed velocities (VelocityRows<Dim, T.old>::data()).
+  // The sums from the packed velocities (VelocityRows<Dim, T.old>::data()); with
+  // T.nodal also nodal[j] = w_ip v_i for the stencil's nodes j (St::count values).
   template <TensorTerms T>
   static GatherSums<Dim> gather(const St& st, const GridGeometry<Dim>& g,
-                                const Real* __restrict rows) {
+                                const Real* __restrict rows, Vec<Dim>* nodal = nullptr) {
     Real wd[Dim][S];
     for (int a = 0; a < Dim; ++a)
       for (int k = 0; k < S; ++k) wd[a][k] = st.w[a][k] * st.d[a][k];
     Partial<T> part;
-    gather_axis<0, T>(st, wd, g.strides(), st.base_node, rows, part);
+    gather_axis<0, T>(st, wd, g.strides(), st.base_node, rows, nodal, 0, Real(1), part);
     GatherSums<Dim> out;
     Real sum[VR<T>::N];
     part.W.store(sum);
@@ -196,11 +211,14 @@ class TensorTransfer {
 
   // Top down: on entry to axis A, the node value is
   //   alpha prod_{b>=A} w_b + sum_{a>=A} gamma[a] (prod_{b>=A} w_b) d_a
-  //                         + sum_{a>=A} beta[a] dw_a prod_{b>=A, b!=a} w_b.
-  template <int A, TensorTerms T>
-  [[gnu::always_inline]] static inline void scatter_axis(
-      const St& st, const Real (&wd)[Dim][S], const std::array<long, Dim>& stride, long node,
-      const P& alpha, const P (&gamma)[Dim], const P (&beta)[Dim], Real* __restrict sums) {
+  //                         + sum_{a>=A} beta[a] dw_a prod_{b>=A, b!=a} w_b;
+  // j is the stencil index of the axes before A, w_before = prod_{b<A} w_b.
+  template <int A, TensorTerms T, int K>
+  MPMTB_INLINE static inline void scatter_axis(const St& st, const Real (&wd)[Dim][S],
+                                               const std::array<long, Dim>& stride, long node,
+                                               const P& alpha, const P (&gamma)[Dim],
+                                               const P (&beta)[Dim], const P (&nodal)[K], int j,
+                                               Real w_before, Real* __restrict sums) {
     for (int k = 0; k < S; ++k) {
       const Real w = st.w[A][k];
       P al = w * alpha;
@@ -208,6 +226,7 @@ class TensorTransfer {
       if constexpr (T.gradient) al.add_scaled(st.dw[A][k], beta[A]);
       const long n = node + k * stride[A];
       if constexpr (A == Dim - 1) {
+        if constexpr (T.nodal) al.add_scaled(w_before * w, nodal[j * S + k]);
         Real* out = sums + n * N;
         P sum = P::load(out);
         sum += al;
@@ -218,7 +237,7 @@ class TensorTransfer {
           if constexpr (T.moment) g2[a] = w * gamma[a];
           if constexpr (T.gradient) b2[a] = w * beta[a];
         }
-        scatter_axis<A + 1, T>(st, wd, stride, n, al, g2, b2, sums);
+        scatter_axis<A + 1, T>(st, wd, stride, n, al, g2, b2, nodal, j * S + k, w_before * w, sums);
       }
     }
   }
@@ -234,10 +253,10 @@ class TensorTransfer {
     GR Dm[Dim], Gr[Dim];
   };
   template <int A, TensorTerms T>
-  [[gnu::always_inline]] static inline void gather_axis(const St& st, const Real (&wd)[Dim][S],
-                                                        const std::array<long, Dim>& stride,
-                                                        long node, const Real* __restrict rows,
-                                                        Partial<T>& out) {
+  MPMTB_INLINE static inline void gather_axis(const St& st, const Real (&wd)[Dim][S],
+                                              const std::array<long, Dim>& stride, long node,
+                                              const Real* __restrict rows, Vec<Dim>* nodal, int j,
+                                              Real w_before, Partial<T>& out) {
     using GR = typename Partial<T>::GR;
     constexpr int N = VR<T>::N;
     out.W = GR::zero();
@@ -250,12 +269,16 @@ class TensorTransfer {
       const long n = node + k * stride[A];
       if constexpr (A == Dim - 1) {
         const GR u = GR::load(rows + n * N);
+        if constexpr (T.nodal) {
+          const Real w_ip = w_before * w;
+          for (int a = 0; a < Dim; ++a) nodal[j * S + k][a] = w_ip * rows[n * N + a];
+        }
         out.W.add_scaled(w, u);
         if constexpr (T.moment) out.Dm[A].add_scaled(wd[A][k], u);
         if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw[A][k], u);
       } else {
         Partial<T> sub;
-        gather_axis<A + 1, T>(st, wd, stride, n, rows, sub);
+        gather_axis<A + 1, T>(st, wd, stride, n, rows, nodal, j * S + k, w_before * w, sub);
         out.W.add_scaled(w, sub.W);
         if constexpr (T.moment) out.Dm[A].add_scaled(wd[A][k], sub.W);
         if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw[A][k], sub.W);

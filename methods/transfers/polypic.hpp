@@ -25,6 +25,7 @@
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
 #include "core/stencil.hpp"
+#include "core/tensor_transfer.hpp"
 
 namespace mpmtb {
 
@@ -192,6 +193,17 @@ class PolypicPolicy {
     f_i -= s.tauV * grad;
   }
 
+  // The base solver's fast path (core/tensor_transfer.hpp): mass and force as
+  // APIC's, the momentum as a field over the stencil's nodes (TensorTerms::nodal).
+  using TensorPath = PolypicPolicy;
+  static constexpr TensorTerms scatter_terms{.gradient = true, .nodal = true};
+  void scatter_form(const Source& s, ScatterForm<Dim>& form) const {
+    using F_ = ScatterForm<Dim>;
+    form.alpha[F_::m] = s.m;
+    for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(F_::f) = -s.tauV.col(a);
+    form.nodal = s.mv;
+  }
+
   struct Gather {
     Modes modes;
     V v = V::Zero();
@@ -203,6 +215,12 @@ class PolypicPolicy {
     g.modes.build(st, dx_);
     for (auto& x : g.wv) x.setZero();
     return g;
+  }
+  static constexpr TensorTerms gather_terms{.gradient = true, .nodal = true};
+  // The sums have filled g.wv (core/policy_hooks.hpp: tensor_gather).
+  void gather_from(const GatherSums<Dim>& sums, Gather& g) const {
+    g.v = sums.v;
+    g.grad_v = sums.G;
   }
   void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
     g.wv[g.modes.node_index(d)] = w * v_i;

@@ -68,6 +68,11 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       P.add(x, random_vector<Dim>(rng), 0.7, 0.2, 0);
       P.C[0] = random_matrix<Dim>(rng);
       P.F[0] = Mat<Dim>::Identity() + 0.1 * random_matrix<Dim>(rng);
+      if constexpr (requires { Policy::transfer_state_size; }) {
+        // Per-particle transfer state (PolyPIC's higher modes), random as C_p.
+        P.use_transfer_state(Policy::transfer_state_size);
+        for (Real& q : P.transfer_state) q = std::uniform_real_distribution<Real>(-1, 1)(rng);
+      }
       const Mat<Dim> tauV = random_matrix<Dim>(rng);
       const Stencil<Dim, Kernel> st(P.x[0], geo);
       const auto src = prepare_source(policy, P, 0, tauV, st);  // as the solver calls it
@@ -101,8 +106,7 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       VelocityRows<Dim, Policy::gather_terms.old> rows;
       rows.resize(ref.size());
       rows.pack(0, static_cast<long>(ref.size()), ref.v.data(), ref.v_old.data());
-      const auto g_fast = policy.gather_from(
-          TensorTransfer<Dim, Kernel>::template gather<Policy::gather_terms>(st, geo, rows.data()));
+      auto g_fast = tensor_gather(policy, st, geo, rows.data());
       Particles<Dim> Pr = P, Pf = P;
       policy.finish(g_ref, Pr, 0, 1e-2);
       policy.finish(g_fast, Pf, 0, 1e-2);
