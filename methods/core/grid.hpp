@@ -75,6 +75,44 @@ struct GridGeometry {
   long node_count_ = 0;
 };
 
+// A box of node indices [lo, hi] (inclusive per axis; empty when lo > hi),
+// swept as rows: runs of consecutive nodes along the last axis.
+template <int Dim>
+struct NodeBox {
+  std::array<int, Dim> lo{}, hi{};
+  NodeBox() { lo.fill(0), hi.fill(-1); }
+
+  long rows() const {
+    long r = 1;
+    for (int a = 0; a + 1 < Dim; ++a) r *= std::max(0, hi[a] - lo[a] + 1);
+    return hi[Dim - 1] < lo[Dim - 1] ? 0 : r;
+  }
+  long nodes() const {
+    const long r = rows();
+    return r ? r * (hi[Dim - 1] - lo[Dim - 1] + 1) : 0;
+  }
+  // First node and length of row r (0 <= r < rows()) on a grid of these strides.
+  std::pair<long, int> row(long r, const std::array<long, Dim>& strides) const {
+    long node = lo[Dim - 1];
+    for (int a = Dim - 2; a >= 0; --a) {
+      const long extent = hi[a] - lo[a] + 1;
+      node += (lo[a] + r % extent) * strides[a];
+      r /= extent;
+    }
+    return {node, hi[Dim - 1] - lo[Dim - 1] + 1};
+  }
+  // f(first, count) for every row, in parallel when the box is large.
+  template <class F>
+  void for_each_row(const std::array<long, Dim>& strides, F&& f) const {
+    const long n = rows();
+#pragma omp parallel for schedule(static) if (nodes() >= kParallelMinimum)
+    for (long r = 0; r < n; ++r) {
+      const auto [first, count] = row(r, strides);
+      f(first, static_cast<long>(count));
+    }
+  }
+};
+
 // Nodal fields. p_i is the momentum transferred from the particles, f_i the
 // internal force; the grid update turns them into v_i.
 template <int Dim>
@@ -86,11 +124,10 @@ struct Grid {
   std::vector<Vec<Dim>> v;           // v_i  velocity after the grid update
   std::vector<Vec<Dim>> v_old;       // v_i before forces (kept for FLIP-like transfers)
   std::vector<std::uint8_t> pinned;  // nodes held at rest by pinned particles
-  // The box of node indices [active_lo, active_hi] (inclusive) outside which
-  // every nodal field is zero: the solver clears, updates and sweeps only this
-  // box, so the grid's cost follows the region the particles occupy, not the
-  // domain. Empty (lo > hi) on a fresh grid.
-  std::array<int, Dim> active_lo{}, active_hi{};
+  // The box of nodes outside which every nodal field is zero: the solver
+  // clears, updates and sweeps only this box, so the grid's cost follows the
+  // region the particles occupy, not the domain. Empty on a fresh grid.
+  NodeBox<Dim> active;
 
   explicit Grid(const GridGeometry<Dim>& g = {}) : geo(g) {
     const auto n = static_cast<std::size_t>(g.node_count());
@@ -100,32 +137,13 @@ struct Grid {
     v.assign(n, Vec<Dim>::Zero());
     v_old.assign(n, Vec<Dim>::Zero());
     pinned.assign(n, 0);
-    active_lo.fill(0);
-    active_hi.fill(-1);
   }
   std::size_t size() const { return m.size(); }
 
-  // Number of rows of the active box: runs of consecutive nodes along the last axis.
-  long active_rows() const {
-    long rows = 1;
-    for (int a = 0; a + 1 < Dim; ++a) rows *= std::max(0, active_hi[a] - active_lo[a] + 1);
-    return active_hi[Dim - 1] < active_lo[Dim - 1] ? 0 : rows;
-  }
-  // Number of nodes in the active box.
-  long active_nodes() const {
-    const long rows = active_rows();
-    return rows ? rows * (active_hi[Dim - 1] - active_lo[Dim - 1] + 1) : 0;
-  }
-  // First node and length of active row r (0 <= r < active_rows()).
-  std::pair<long, int> active_row(long r) const {
-    long node = active_lo[Dim - 1];
-    for (int a = Dim - 2; a >= 0; --a) {
-      const long extent = active_hi[a] - active_lo[a] + 1;
-      node += (active_lo[a] + r % extent) * geo.strides()[a];
-      r /= extent;
-    }
-    return {node, active_hi[Dim - 1] - active_lo[Dim - 1] + 1};
-  }
+  // The active box's rows (runs of consecutive nodes along the last axis).
+  long active_rows() const { return active.rows(); }
+  long active_nodes() const { return active.nodes(); }
+  std::pair<long, int> active_row(long r) const { return active.row(r, geo.strides()); }
 };
 
 }  // namespace mpmtb

@@ -23,11 +23,16 @@
 // round-off; for degree 4 the error is O(dx^2).
 // The step writes lap_p to q[target] and the magnitude 2 Dim / dx^2 of the
 // grid operator's diagonal to q[target + 1], for a linearly implicit update.
-// Deterministic: the transfer is serial in particle order.
+// The cost follows the particles: the transfer scatters in parallel over block
+// colours as P2G does (core/particle_blocks.hpp; the summation order, and so
+// the result, does not depend on the thread count), and the grid passes sweep
+// only the box of nodes the particles reach.
 #pragma once
 
+#include <algorithm>
 #include <vector>
 
+#include "core/particle_blocks.hpp"
 #include "core/state.hpp"
 #include "core/stencil.hpp"
 
@@ -46,60 +51,80 @@ class NonlocalLaplacian {
       any = any || requests_[k].active();
     }
     if (!any) return;
+    rebin(s);
     transfer_to_grid(s);
     grid_laplacian(s.grid.geo);
     interpolate_back(s);
   }
-
-  // Grid values of the last call (tests).
-  const std::vector<Real>& grid_mass() const { return m_; }
-  const std::vector<Real>& grid_value() const { return q_; }
 
  private:
   bool requested(const Particles<Dim>& P, std::size_t p) const {
     return requests_[P.material[p]].active();
   }
 
+  // Zeroes the fields over the box of the previous call, then bins the particles
+  // at their current positions into a new box: outside it every field is zero.
+  void rebin(const State<Dim>& s) {
+    const auto& geo = s.grid.geo;
+    const auto n = static_cast<std::size_t>(geo.node_count());
+    if (m_.size() != n) {
+      m_.assign(n, 0), q_.assign(n, 0), lap_.assign(n, 0);
+    } else {
+      box_.for_each_row(geo.strides(), [&](long first, long count) {
+        std::fill_n(m_.begin() + first, count, Real(0));
+        std::fill_n(q_.begin() + first, count, Real(0));
+        std::fill_n(lap_.begin() + first, count, Real(0));
+      });
+    }
+    blocks_.bin(s.particles.x, geo, box_);
+  }
+
   void transfer_to_grid(const State<Dim>& s) {
     const auto& P = s.particles;
     const auto& geo = s.grid.geo;
-    const auto n = static_cast<std::size_t>(geo.node_count());
-    m_.assign(n, 0);
-    q_.assign(n, 0);
-    for (std::size_t p = 0; p < P.size(); ++p) {
-      if (!requested(P, p)) continue;
+    blocks_.for_each_coloured(s, [&](int p) {
+      if (!requested(P, p)) return;
       const Real mp = P.m[p], mq = mp * P.state_of(p)[requests_[P.material[p]].source];
       StencilT(P.x[p], geo)
           .for_each_node(geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
             m_[node] += w * mp;
             q_[node] += w * mq;
           });
-    }
-    const long nodes = static_cast<long>(n);
-#pragma omp parallel for schedule(static) if (nodes >= kParallelMinimum)
-    for (long i = 0; i < nodes; ++i) {
-      if (m_[i] > 0) q_[i] /= m_[i];
-    }
+    });
+    for_each_node(
+        [&](long i) {
+          if (m_[i] > 0) q_[i] /= m_[i];
+        },
+        geo);
   }
 
+  // Over the box: a node with mass lies inside the particles' stencils, its
+  // neighbours inside the box's pad layers.
   void grid_laplacian(const GridGeometry<Dim>& geo) {
-    lap_.assign(q_.size(), 0);
     const Real inv_dx2 = 1 / (geo.dx * geo.dx);
-    const long nodes = static_cast<long>(q_.size());
-#pragma omp parallel for schedule(static) if (nodes >= kParallelMinimum)
-    for (long i = 0; i < nodes; ++i) {
-      if (!(m_[i] > 0)) continue;
-      const auto idx = geo.multi_index(i);
-      Real sum = 0;
-      for (int a = 0; a < Dim; ++a) {
-        const long stride = geo.strides()[a];
-        // A neighbour off the grid or without mass mirrors the node (zero flux).
-        const Real lo = idx[a] > 0 && m_[i - stride] > 0 ? q_[i - stride] : q_[i];
-        const Real hi = idx[a] + 1 < geo.nodes(a) && m_[i + stride] > 0 ? q_[i + stride] : q_[i];
-        sum += (hi - q_[i]) + (lo - q_[i]);
-      }
-      lap_[i] = sum * inv_dx2;
-    }
+    for_each_node(
+        [&](long i) {
+          if (!(m_[i] > 0)) return;
+          const auto idx = geo.multi_index(i);
+          Real sum = 0;
+          for (int a = 0; a < Dim; ++a) {
+            const long stride = geo.strides()[a];
+            // A neighbour off the grid or without mass mirrors the node (zero flux).
+            const Real lo = idx[a] > 0 && m_[i - stride] > 0 ? q_[i - stride] : q_[i];
+            const Real hi =
+                idx[a] + 1 < geo.nodes(a) && m_[i + stride] > 0 ? q_[i + stride] : q_[i];
+            sum += (hi - q_[i]) + (lo - q_[i]);
+          }
+          lap_[i] = sum * inv_dx2;
+        },
+        geo);
+  }
+
+  template <class F>
+  void for_each_node(F&& f, const GridGeometry<Dim>& geo) const {
+    box_.for_each_row(geo.strides(), [&](long first, long count) {
+      for (long i = first; i < first + count; ++i) f(i);
+    });
   }
 
   void interpolate_back(State<Dim>& s) {
@@ -123,7 +148,9 @@ class NonlocalLaplacian {
   }
 
   std::vector<LaplacianRequest> requests_;
-  std::vector<Real> m_, q_, lap_;
+  std::vector<Real> m_, q_, lap_;  // over the whole grid, zero outside box_
+  NodeBox<Dim> box_;
+  ParticleBlocks<Dim, Kernel> blocks_;
 };
 
 }  // namespace mpmtb

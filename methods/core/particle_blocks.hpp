@@ -23,11 +23,10 @@ class ParticleBlocks {
   // GridGeometry::pad layers (the mirrors of the wall ghosts), and sorts the
   // particle ids by colour, then block (a stable counting sort: particle order
   // within a block).
-  void bin(State<Dim>& s) {
-    Grid<Dim>& g = s.grid;
-    const auto& geo = g.geo;
+  void bin(State<Dim>& s) { bin(s.particles.x, s.grid.geo, s.grid.active); }
+  // The same for positions x on a grid geo: `box` is set to their nodes.
+  void bin(const std::vector<Vec<Dim>>& x, const GridGeometry<Dim>& geo, NodeBox<Dim>& box) {
     constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
-    const auto& x = s.particles.x;
     const long n = static_cast<long>(x.size());
     const Real inv_dx = 1 / geo.dx;
     int lo[Dim], hi[Dim];
@@ -51,8 +50,8 @@ class ParticleBlocks {
       }
     }
     for (int a = 0; a < Dim; ++a) {
-      g.active_lo[a] = n ? std::max(0, lo[a] - pad) : 0;
-      g.active_hi[a] = n ? std::min(geo.nodes(a) - 1, hi[a] + S - 1 + pad) : -1;
+      box.lo[a] = n ? std::max(0, lo[a] - pad) : 0;
+      box.hi[a] = n ? std::min(geo.nodes(a) - 1, hi[a] + S - 1 + pad) : -1;
     }
     // Blocks of S cells from the lowest first node, half of them per colour and axis.
     std::array<int, kColouredAxes> half{};

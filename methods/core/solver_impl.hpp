@@ -412,12 +412,7 @@ class Solver final : public Stepper<Dim> {
   // along the last axis), in parallel.
   template <class F>
   static void for_each_active_row(const Grid<Dim>& g, F&& f) {
-    const long rows = g.active_rows();
-#pragma omp parallel for schedule(static) if (g.active_nodes() >= kParallelMinimum)
-    for (long r = 0; r < rows; ++r) {
-      const auto [first, count] = g.active_row(r);
-      f(first, static_cast<long>(count));
-    }
+    g.active.for_each_row(g.geo.strides(), f);
   }
   // f(node) for every node of the active box, in parallel over its rows.
   template <class F>

@@ -132,5 +132,33 @@ TEST(NonlocalLaplacian, SecondOrderOnAQuarticField) {
   EXPECT_LT(order, 2.2);
 }
 
+// The operator keeps its grid between calls and clears only the box of nodes
+// its last particles reached: after the body moves by several cells, a second
+// call must equal a fresh operator's, bit for bit (no value left behind).
+TEST(NonlocalLaplacian, ReusedAfterTheBodyMovesEqualsAFreshOperator) {
+  const Scene scene = testing::scene_from_toml(block_toml(2, 32, "quadratic"), {.dim = 2});
+  State<2> reused_state = build_state<2>(scene), fresh_state = build_state<2>(scene);
+  // The cubic field at the particles, moved by `shift` first.
+  const auto place = [](State<2>& s, const Vec<2>& shift) {
+    for (std::size_t p = 0; p < s.particles.size(); ++p) {
+      s.particles.x[p] += shift;
+      s.particles.state_of(p)[0] = cubic2(s.particles.x[p]);
+    }
+  };
+  place(reused_state, Vec<2>::Zero());
+  NonlocalLaplacian<2, QuadraticKernel> reused, fresh;
+  reused.apply(reused_state);
+  const Real dx = reused_state.grid.geo.dx;
+  const Vec<2> shift(3.3 * dx, -2.6 * dx);
+  place(reused_state, shift);
+  place(fresh_state, shift);
+  reused.apply(reused_state);
+  fresh.apply(fresh_state);
+  const auto& P = reused_state.particles;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    ASSERT_EQ(P.state_of(p)[2], fresh_state.particles.state_of(p)[2]) << "particle " << p;
+  }
+}
+
 }  // namespace
 }  // namespace mpmtb
