@@ -11,4 +11,4 @@ cd ..
 # Sanitizer stage: the unit tests again, built with ASan + UBSan in ./build-asan.
 bash scripts/sanitize.sh
 # Bounded coverage-guided fuzz of the scene parser (libFuzzer; skipped without clang).
-bash scripts/fuzz.sh 200000 60
+FUZZ_TREE=build-asan bash scripts/fuzz.sh 200000 60
