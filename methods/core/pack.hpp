@@ -17,13 +17,8 @@
 #pragma GCC diagnostic push
 #pragma GCC diagnostic ignored "-Wpsabi"
 
-// The transfers' per-node code is inlined whole; sanitizer builds leave it to
-// the compiler (CMakeLists.txt).
-#ifdef MPMTB_NO_FORCE_INLINE
-#define MPMTB_INLINE
-#else
+// The transfers' per-node code is inlined whole.
 #define MPMTB_INLINE [[gnu::always_inline]]
-#endif
 
 namespace mpmtb {
 
