@@ -83,12 +83,13 @@ if [ "${QUICK:-0}" != 1 ]; then
     measure domain4x double "$threads" 4 "$block" --cells 128 --set grid.length=4 \
       --set 'domain.max=[4,4,4]'
   done
-  # Every transfer x kernel, 3D (32,768 particles) and 2D (128^2 = 16,384), 2 threads.
+  # Every transfer x kernel, 3D (32,768 particles) and 2D (128^2 = 16,384), 2 threads
+  # (the block's neo-Hookean material; each transfer's default parameters).
   for dim in 3 2; do
     cells=32 dt=()
     # 2D: 128 cells, and a step inside the CFL limit dx / c = 7.8e-5 of that grid.
     [ "$dim" = 2 ] && cells=128 dt=(--set time.dt=5e-5)
-    for transfer in pic flip apic mls; do
+    for transfer in pic flip apic mls tpic polypic xpic aflip asflip; do
       for kernel in linear quadratic cubic gimp; do
         measure transfers double 2 1 "$block" --dim "$dim" --cells "$cells" \
           --transfer "$transfer" --kernel "$kernel" "${dt[@]}"
