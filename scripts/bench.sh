@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Throughput table: builds mpmtb in double (./build) and float (./build-float),
 # runs each bench case REPEATS times and writes the medians of particle-steps
-# per second to results/bench/throughput.csv (and prints the table).
+# per second to results/bench/throughput.csv (prints the table and draws it:
+# analysis/bench_plots.py).
 #   REPEATS=5 (default)  runs per case; the median is reported
 #   QUICK=1              only the pinned block and the 2D snow scene
 #   MPMTB_ARCH=auto      passed to cmake for both builds (-march; auto: x86-64-v3
@@ -41,8 +42,15 @@ measure() {
   : >"$rates"
   for _ in $(seq "$REPEATS"); do
     rm -rf "$run"
+    local status=0
     OMP_NUM_THREADS=$threads "$exe" run "$scene" --threads "$threads" "$@" --out "$run" >/dev/null 2>&1 ||
-      { echo "bench: case $name failed: $exe run $scene $*" >&2; exit 1; }
+      status=$?
+    if [ "$status" = 3 ]; then
+      # Unstable (exit status 3): no throughput to report; the row is left out.
+      echo "bench: case $name unstable, left out: $exe run $scene $* ($(field "$run/summary.json" reason))" >&2
+      return 0
+    fi
+    [ "$status" = 0 ] || { echo "bench: case $name failed: $exe run $scene $*" >&2; exit 1; }
     field "$run/summary.json" particle_steps_per_second >>"$rates"
   done
   local median
@@ -100,3 +108,5 @@ fi
 cp "$rows" "$out.tmp" && mv "$out.tmp" "$out"
 echo "bench: wrote $out"
 column -s, -t "$out"
+# Figures next to the table: targets.png, scaling.png, transfers.png.
+/usr/bin/python3 analysis/bench_plots.py "$out"
