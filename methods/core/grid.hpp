@@ -111,6 +111,13 @@ struct NodeBox {
       f(first, static_cast<long>(count));
     }
   }
+  // f(node) for every node, in parallel over the rows.
+  template <class F>
+  void for_each_node(const std::array<long, Dim>& strides, F&& f) const {
+    for_each_row(strides, [&](long first, long count) {
+      for (long i = first; i < first + count; ++i) f(i);
+    });
+  }
 };
 
 // Nodal fields. p_i is the momentum transferred from the particles, f_i the

@@ -91,39 +91,27 @@ class NonlocalLaplacian {
             q_[node] += w * mq;
           });
     });
-    for_each_node(
-        [&](long i) {
-          if (m_[i] > 0) q_[i] /= m_[i];
-        },
-        geo);
+    box_.for_each_node(geo.strides(), [&](long i) {
+      if (m_[i] > 0) q_[i] /= m_[i];
+    });
   }
 
   // Over the box: a node with mass lies inside the particles' stencils, its
   // neighbours inside the box's pad layers.
   void grid_laplacian(const GridGeometry<Dim>& geo) {
     const Real inv_dx2 = 1 / (geo.dx * geo.dx);
-    for_each_node(
-        [&](long i) {
-          if (!(m_[i] > 0)) return;
-          const auto idx = geo.multi_index(i);
-          Real sum = 0;
-          for (int a = 0; a < Dim; ++a) {
-            const long stride = geo.strides()[a];
-            // A neighbour off the grid or without mass mirrors the node (zero flux).
-            const Real lo = idx[a] > 0 && m_[i - stride] > 0 ? q_[i - stride] : q_[i];
-            const Real hi =
-                idx[a] + 1 < geo.nodes(a) && m_[i + stride] > 0 ? q_[i + stride] : q_[i];
-            sum += (hi - q_[i]) + (lo - q_[i]);
-          }
-          lap_[i] = sum * inv_dx2;
-        },
-        geo);
-  }
-
-  template <class F>
-  void for_each_node(F&& f, const GridGeometry<Dim>& geo) const {
-    box_.for_each_row(geo.strides(), [&](long first, long count) {
-      for (long i = first; i < first + count; ++i) f(i);
+    box_.for_each_node(geo.strides(), [&](long i) {
+      if (!(m_[i] > 0)) return;
+      const auto idx = geo.multi_index(i);
+      Real sum = 0;
+      for (int a = 0; a < Dim; ++a) {
+        const long stride = geo.strides()[a];
+        // A neighbour off the grid or without mass mirrors the node (zero flux).
+        const Real lo = idx[a] > 0 && m_[i - stride] > 0 ? q_[i - stride] : q_[i];
+        const Real hi = idx[a] + 1 < geo.nodes(a) && m_[i + stride] > 0 ? q_[i + stride] : q_[i];
+        sum += (hi - q_[i]) + (lo - q_[i]);
+      }
+      lap_[i] = sum * inv_dx2;
     });
   }
 

@@ -417,9 +417,7 @@ class Solver final : public Stepper<Dim> {
   // f(node) for every node of the active box, in parallel over its rows.
   template <class F>
   static void for_each_active_node(const Grid<Dim>& g, F&& f) {
-    for_each_active_row(g, [&](long first, long count) {
-      for (long i = first; i < first + count; ++i) f(i);
-    });
+    g.active.for_each_node(g.geo.strides(), f);
   }
 
   Parameters transfer_params_;
