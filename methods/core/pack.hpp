@@ -7,8 +7,14 @@
 #pragma once
 
 #include <algorithm>
+#include <cmath>
 #include <cstring>
+#include <type_traits>
 #include <utility>
+
+#if defined(__FMA__) || defined(__AVX512F__)
+#include <immintrin.h>
+#endif
 
 #include "core/types.hpp"
 
@@ -48,6 +54,7 @@ struct PackOf<64> {
 // N reals (N * sizeof(Real) a multiple of 16 bytes) as K registers.
 template <int N>
 struct Row {
+  static constexpr int count = N;  // reals
   static constexpr int bytes = std::min<int>(kSimdBytes, N * sizeof(Real));
   static constexpr int lanes = bytes / sizeof(Real);
   static constexpr int K = N / lanes;
@@ -90,10 +97,101 @@ struct Row {
     for (int k = 0; k < K; ++k) v[k] += a.v[k];
     return *this;
   }
-  // *this += s a
+  // *this += s a, each lane as one fused multiply-add (rounded once). The
+  // fusion is spelled here, not left to the compiler (-ffp-contract=off): every
+  // target computes the same bits, with the FMA instruction where it has one
+  // and std::fma (correctly rounded, so equal) where it has not, and every
+  // transfer that sums through a Row rounds the same way.
   MPMTB_INLINE void add_scaled(Real s, const Row& a) {
-    for (int k = 0; k < K; ++k) v[k] += s * a.v[k];
+    const Pack sp = s - Pack{};  // s in every lane
+    for (int k = 0; k < K; ++k) v[k] = fused(sp, a.v[k], v[k]);
   }
+
+ private:
+  // x y + z per lane, rounded once.
+  MPMTB_INLINE static Pack fused(Pack x, Pack y, Pack z) {
+    constexpr bool is_double = std::is_same_v<Real, double>;
+#if defined(__AVX512F__)
+    if constexpr (bytes == 64 && is_double) return _mm512_fmadd_pd(x, y, z);
+    if constexpr (bytes == 64 && !is_double) return _mm512_fmadd_ps(x, y, z);
+#endif
+#if defined(__FMA__)
+    if constexpr (bytes == 32 && is_double) return _mm256_fmadd_pd(x, y, z);
+    if constexpr (bytes == 32 && !is_double) return _mm256_fmadd_ps(x, y, z);
+    if constexpr (bytes == 16 && is_double) return _mm_fmadd_pd(x, y, z);
+    if constexpr (bytes == 16 && !is_double) return _mm_fmadd_ps(x, y, z);
+#endif
+    Pack r;
+    for (int i = 0; i < lanes; ++i) r[i] = std::fma(x[i], y[i], z[i]);
+    return r;
+  }
+};
+
+// A Row built lane by lane, with the Eigen-like setters the transfers write
+// their P2G form with (col[i] = x, col.segment<K>(i) = vector, +=). The lanes
+// are set in registers: a column written to memory piecewise and then read as
+// whole registers would stall on store forwarding (the loads span several
+// narrower stores), which the profile showed as the costliest part of P2G's
+// set-up.
+template <int N>
+class RowBuilder {
+ public:
+  MPMTB_INLINE RowBuilder() : row_(Row<N>::zero()) {}
+  MPMTB_INLINE static RowBuilder Zero() { return {}; }
+  MPMTB_INLINE void setZero() { row_ = Row<N>::zero(); }
+  MPMTB_INLINE const Row<N>& row() const { return row_; }
+  MPMTB_INLINE Real operator[](int i) const { return row_.v[i / lanes][i % lanes]; }
+
+  class Lane {
+   public:
+    MPMTB_INLINE Lane(RowBuilder& c, int i) : c_(c), i_(i) {}
+    MPMTB_INLINE Lane& operator=(Real x) {
+      c_.set(i_, x);
+      return *this;
+    }
+    MPMTB_INLINE Lane& operator+=(Real x) {
+      c_.set(i_, std::as_const(c_)[i_] + x);
+      return *this;
+    }
+    MPMTB_INLINE operator Real() const { return std::as_const(c_)[i_]; }
+
+   private:
+    RowBuilder& c_;
+    int i_;
+  };
+  MPMTB_INLINE Lane operator[](int i) { return {*this, i}; }
+
+  // Lanes first .. first + K - 1, as an Eigen K-vector.
+  template <int K>
+  class Segment {
+   public:
+    MPMTB_INLINE Segment(RowBuilder& c, int first) : c_(c), first_(first) {}
+    template <class E>
+    MPMTB_INLINE Segment& operator=(const Eigen::MatrixBase<E>& e) {
+      const Eigen::Matrix<Real, K, 1> x = e;
+      for (int k = 0; k < K; ++k) c_.set(first_ + k, x[k]);
+      return *this;
+    }
+    template <class E>
+    MPMTB_INLINE Segment& operator+=(const Eigen::MatrixBase<E>& e) {
+      const Eigen::Matrix<Real, K, 1> x = e;
+      for (int k = 0; k < K; ++k) c_.set(first_ + k, std::as_const(c_)[first_ + k] + x[k]);
+      return *this;
+    }
+
+   private:
+    RowBuilder& c_;
+    int first_;
+  };
+  template <int K>
+  MPMTB_INLINE Segment<K> segment(int first) {
+    return {*this, first};
+  }
+
+ private:
+  static constexpr int lanes = Row<N>::lanes;
+  MPMTB_INLINE void set(int i, Real x) { row_.v[i / lanes][i % lanes] = x; }
+  Row<N> row_;
 };
 
 }  // namespace mpmtb

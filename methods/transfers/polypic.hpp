@@ -18,9 +18,11 @@
 // it to round-off).
 #pragma once
 
+#include <algorithm>
 #include <cmath>
 #include <limits>
 #include <string_view>
+#include <utility>
 
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
@@ -103,14 +105,16 @@ struct PolyModes {
 
   // out[j] = sum_k T_a[j_a][k] in[j with j_a -> k] along one axis, with T_a = e[a]
   // (nodal values -> mode sums) or its transpose (mode coefficients -> nodal values).
-  template <bool Transpose>
-  void apply_axis(int a, const Vec<Dim>* in, Vec<Dim>* out) const {
-    const int stride = ipow(S, Dim - 1 - a);
+  // The axis is a template parameter: its stride is then a constant, and the
+  // index arithmetic (a division and a remainder per entry) folds away.
+  template <bool Transpose, int A>
+  void apply_axis(const Vec<Dim>* in, Vec<Dim>* out) const {
+    constexpr int stride = ipow(S, Dim - 1 - A);
     for (int j = 0; j < count; ++j) {
       const int ja = (j / stride) % S, base = j - ja * stride;
       Vec<Dim> acc = Vec<Dim>::Zero();
       for (int k = 0; k < S; ++k)
-        acc += (Transpose ? e[a][k][ja] : e[a][ja][k]) * in[base + k * stride];
+        acc += (Transpose ? e[A][k][ja] : e[A][ja][k]) * in[base + k * stride];
       out[j] = acc;
     }
   }
@@ -118,10 +122,10 @@ struct PolyModes {
   template <bool Transpose>
   void transform(Vec<Dim>* values) const {
     Vec<Dim> tmp[count];
-    for (int a = 0; a < Dim; ++a) {
-      apply_axis<Transpose>(a, values, tmp);
-      for (int j = 0; j < count; ++j) values[j] = tmp[j];
+    [&]<int... A>(std::integer_sequence<int, A...>) {
+      ((apply_axis<Transpose, A>(values, tmp), std::copy_n(tmp, count, values)), ...);
     }
+    (std::make_integer_sequence<int, Dim>{});
   }
 
   // Mode r = (r_0, ..., r_{Dim-1}) as a flat index: 0 is the constant, linear(a)
