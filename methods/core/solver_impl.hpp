@@ -40,6 +40,10 @@ class Solver final : public Stepper<Dim> {
   static constexpr bool kFiltersOldVelocity = requires(const Policy& q) {
     q.old_velocity_series();
   };
+  // A transfer that never reads v_old scatters (m_i, p_i + dt f_i): the force
+  // folded into the momentum, half the row per node (NodeSums, kFolded).
+  static constexpr bool kFoldForce =
+      kTensorPath && !Transfer::needs_old_velocity && !kFiltersOldVelocity;
 
  public:
   Solver(Parameters& transfer_params) : transfer_params_(transfer_params) {}
@@ -55,13 +59,12 @@ class Solver final : public Stepper<Dim> {
   }
 
   void particles_to_grid(State<Dim>& s, Real dt) override {
-    (void)dt;  // forces are kept apart from momentum; the grid update integrates them
     compute_stresses(s);
     s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
     blocks_.bin(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
-    blocks_.for_each_coloured(s, [&](int p) { scatter_particle<true>(s, policy, p); });
+    blocks_.for_each_coloured(s, [&](int p) { scatter_particle<true>(s, policy, p, dt); });
     if constexpr (kTensorPath) unpack_sums<true, true>(s.grid);
   }
 
@@ -188,7 +191,7 @@ class Solver final : public Stepper<Dim> {
     clear_active_box(s.grid);
     blocks_.bin(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
-    blocks_.for_each_coloured(s, [&](int p) { scatter_particle<false>(s, policy, p); });
+    blocks_.for_each_coloured(s, [&](int p) { scatter_particle<false>(s, policy, p, 0); });
     if constexpr (kTensorPath) {
       unpack_sums<true, false>(s.grid);  // kept for scatter_forces (usf); musl has none
       sums_kept_ = true;
@@ -196,9 +199,9 @@ class Solver final : public Stepper<Dim> {
   }
   // Force, on the blocks scatter_momentum binned (the particles have not moved),
   // added to the momentum sums that scatter_momentum left.
-  void scatter_forces(State<Dim>& s) override {
+  void scatter_forces(State<Dim>& s, Real dt) override {
     compute_stresses(s);
-    blocks_.for_each_coloured(s, [&](int p) { scatter_force(s, p); });
+    blocks_.for_each_coloured(s, [&](int p) { scatter_force(s, p, dt); });
     unpack_sums<kTensorPath, true>(s.grid);
     sums_kept_ = false;
   }
@@ -306,9 +309,10 @@ class Solver final : public Stepper<Dim> {
     for_each_active_row(g, [&](long first, long count) { rows_out.pack(first, count, v, v_old); });
   }
 
-  // kBodyForce = false: the momentum part only (tauV_ is zero then).
+  // kBodyForce = false: the momentum part only (tauV_ is zero then). dt: the
+  // step that folded sums integrate the force over (kFoldForce).
   template <bool kBodyForce>
-  void scatter_particle(State<Dim>& s, const Policy& policy, int p) {
+  void scatter_particle(State<Dim>& s, const Policy& policy, int p, Real dt) {
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
     const StencilT st(P.x[p], g.geo);
@@ -323,8 +327,7 @@ class Solver final : public Stepper<Dim> {
         form.alpha.template segment<Dim>(ScatterForm<Dim>::f) +=
             P.m[p] * s.body_force(P, p, s.time);
       }
-      TensorTransfer<Dim, Kernel>::template scatter<Policy::scatter_terms>(st, g.geo, form,
-                                                                           sums_.data());
+      add_form(st, g.geo, form, dt);
     } else if (!kBodyForce || !s.body_force) {
       st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
         policy.scatter(src, w, grad, d, m[node], mom[node], f[node]);
@@ -345,7 +348,7 @@ class Solver final : public Stepper<Dim> {
 
   // f_i += -V0_p tau_p grad w_ip + w_ip m_p b_p: the force of a gradient-based
   // transfer (Sulsky et al. 1994), the force part of the split P2G.
-  void scatter_force(State<Dim>& s, int p) {
+  void scatter_force(State<Dim>& s, int p, Real dt) {
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
     using Form = ScatterForm<Dim>;
@@ -353,8 +356,19 @@ class Solver final : public Stepper<Dim> {
     for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(Form::f) = -tauV_[p].col(a);
     if (s.body_force)
       form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
-    TensorTransfer<Dim, Kernel>::template scatter<TensorTerms{.gradient = true}>(
-        StencilT(P.x[p], g.geo), g.geo, form, sums_.data());
+    add_form<TensorTerms{.gradient = true}>(StencilT(P.x[p], g.geo), g.geo, form, dt);
+  }
+
+  // The form into the P2G sums, folded with dt or not (kFoldForce).
+  template <TensorTerms T = Policy::scatter_terms>
+  void add_form(const StencilT& st, const GridGeometry<Dim>& geo, const ScatterForm<Dim>& form,
+                Real dt) {
+    using Sums = TensorTransfer<Dim, Kernel>;
+    if constexpr (kFoldForce) {
+      Sums::template scatter_folded<T>(st, geo, form, dt, sums_.data());
+    } else {
+      Sums::template scatter<T>(st, geo, form, sums_.data());
+    }
   }
 
   // v_old <- sum_j c_j Q^j v_old, c = the policy's old_velocity_series(), with
@@ -423,9 +437,9 @@ class Solver final : public Stepper<Dim> {
   Parameters transfer_params_;
   std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
   std::vector<Vec<Dim>> p_kept_;
-  std::vector<Mat<Dim>> tauV_;  // V0_p tau_p, from the materials
-  NodeSums<Dim> sums_;          // the fast path's P2G accumulator
-  bool sums_kept_ = false;      // sums_ holds scatter_momentum's sums (see clear_active_box)
+  std::vector<Mat<Dim>> tauV_;      // V0_p tau_p, from the materials
+  NodeSums<Dim, kFoldForce> sums_;  // the fast path's P2G accumulator
+  bool sums_kept_ = false;          // sums_ holds scatter_momentum's sums (see clear_active_box)
   // The fast path's G2P input: v (and v_old if the policy reads it) for the
   // transfer's gather, v alone for the gradient-based F update and XPIC's filter.
   static constexpr bool kGatherOld = [] {

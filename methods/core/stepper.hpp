@@ -92,7 +92,7 @@ class Stepper {
         const StepReport deformed = update_deformation(s, dt);
         nonlocal_update(s);
         constitutive_update(s, dt);
-        scatter_forces(s);
+        scatter_forces(s, dt);
         update_grid(s, dt);
         r = merged(move_particles(s, dt), deformed);
         break;
@@ -130,8 +130,9 @@ class Stepper {
   // transfer's own momentum (with C_p for affine transfers), no forces.
   virtual void scatter_momentum(State<Dim>& s) = 0;
   // P2G force part: -V0 tau grad w from the current stress and body forces,
-  // added to the grid that scatter_momentum filled.
-  virtual void scatter_forces(State<Dim>& s) = 0;
+  // added to the grid that scatter_momentum filled (for the step dt that
+  // follows: a transfer may fold dt f_i into p_i, see NodeSums).
+  virtual void scatter_forces(State<Dim>& s, Real dt) = 0;
   // v_i = p_i / m_i with the boundary conditions at time t, leaving m, p and f
   // as they were: the velocities that update F (usf, musl).
   virtual void grid_velocities(State<Dim>& s, Real t) = 0;

@@ -42,25 +42,33 @@ struct TensorTerms {
 template <int Dim>
 struct ScatterForm {
   static constexpr int N = Dim == 1 ? 4 : 8;  // whole SIMD registers (core/pack.hpp)
-  using Col = Eigen::Matrix<Real, N, 1>;
-  Col alpha = Col::Zero();
+  using Col = RowBuilder<N>;                  // set in registers (core/pack.hpp), all zero at first
+  Col alpha;
   Col gamma[Dim];
   Col beta[Dim];
   const Vec<Dim>* nodal = nullptr;  // Kernel::support^Dim values (TensorTerms::nodal)
-  ScatterForm() {
-    for (int a = 0; a < Dim; ++a) gamma[a].setZero(), beta[a].setZero();
-  }
   // Slots of the stacked column.
   static constexpr int m = 0, p = 1, f = 1 + Dim;
 };
+
+// Width of a node's sums with the force folded into the momentum, (m_i,
+// p_i + dt f_i) padded to whole registers: half the row of (m_i, p_i, f_i).
+template <int Dim>
+inline constexpr int kFoldedWidth = std::max<int>(Dim == 1 ? 2 : 4,
+                                                  16 / static_cast<int>(sizeof(Real)));
 
 // P2G's accumulator: for every grid node the stacked column (m_i, p_i, f_i,
 // padding) of ScatterForm, its N values side by side. A node's update is then a
 // few contiguous SIMD adds instead of scalar adds to three arrays; the solver
 // unpacks the sums into the grid's fields once per step, over the active box.
-template <int Dim>
+// kFolded: the rows hold (m_i, p_i + dt f_i) instead (TensorTransfer::
+// scatter_folded), for the transfers that never read the velocity before the
+// forces (v_old): the grid update's v_i = (p_i + dt f_i) / m_i + dt g is then the
+// same symplectic Euler step, with half the row to scatter and unpack.
+template <int Dim, bool kFolded = false>
 struct NodeSums {
-  static constexpr int N = ScatterForm<Dim>::N;
+  static constexpr bool folded = kFolded;
+  static constexpr int N = kFolded ? kFoldedWidth<Dim> : ScatterForm<Dim>::N;
   using Form = ScatterForm<Dim>;
   std::vector<Real> values;  // N per node, node-major
 
@@ -75,15 +83,17 @@ struct NodeSums {
   }
   // m_i, p_i, f_i <- the sums of `count` consecutive nodes from `first` (only f_i
   // when kMomentum is false: the sums then hold forces only), and, when kDrain,
-  // zero those sums, so that they are zero again for the next scatter.
+  // zero those sums, so that they are zero again for the next scatter. Folded
+  // rows set m_i and p_i (the force is in p_i) and leave f_i as it is.
   template <bool kMomentum, bool kDrain>
   void unpack(long first, long count, Real* m, Vec<Dim>* p, Vec<Dim>* f) {
+    static_assert(kMomentum || !kFolded, "folded sums always hold the momentum");
     for (long i = first; i < first + count; ++i) {
       Real* s = &values[i * N];
       if constexpr (kMomentum) m[i] = s[Form::m];
       for (int a = 0; a < Dim; ++a) {
         if constexpr (kMomentum) p[i][a] = s[Form::p + a];
-        f[i][a] = s[Form::f + a];
+        if constexpr (!kFolded) f[i][a] = s[Form::f + a];
       }
       if constexpr (kDrain) std::fill_n(s, N, Real(0));
     }
@@ -150,24 +160,25 @@ class TensorTransfer {
   template <TensorTerms T>
   static void scatter(const St& st, const GridGeometry<Dim>& g, const ScatterForm<Dim>& form,
                       Real* __restrict sums) {
-    Real wd[Dim][S];
-    for (int a = 0; a < Dim; ++a)
-      for (int k = 0; k < S; ++k) wd[a][k] = st.w[a][k] * st.d[a][k];
     P gamma[Dim], beta[Dim];
     for (int a = 0; a < Dim; ++a) {
-      if constexpr (T.moment) gamma[a] = P::gather(form.gamma[a].data());
-      if constexpr (T.gradient) beta[a] = P::gather(form.beta[a].data());
+      if constexpr (T.moment) gamma[a] = form.gamma[a].row();
+      if constexpr (T.gradient) beta[a] = form.beta[a].row();
     }
-    P nodal[T.nodal ? St::count : 1];
-    if constexpr (T.nodal) {
-      for (int j = 0; j < St::count; ++j) {
-        Real row[N] = {};
-        for (int a = 0; a < Dim; ++a) row[ScatterForm<Dim>::p + a] = form.nodal[j][a];
-        nodal[j] = P::gather(row);
-      }
+    scatter_rows<T>(st, g, form.alpha.row(), gamma, beta, form.nodal, sums);
+  }
+  // The same into folded sums (NodeSums<Dim, true>): each column of the form
+  // becomes (m, p + dt f) before the stencil loop, so every node adds half a row.
+  template <TensorTerms T>
+  static void scatter_folded(const St& st, const GridGeometry<Dim>& g, const ScatterForm<Dim>& form,
+                             Real dt, Real* __restrict sums) {
+    using PF = Row<kFoldedWidth<Dim>>;
+    PF gamma[Dim], beta[Dim];
+    for (int a = 0; a < Dim; ++a) {
+      if constexpr (T.moment) gamma[a] = fold(form.gamma[a], dt);
+      if constexpr (T.gradient) beta[a] = fold(form.beta[a], dt);
     }
-    scatter_axis<0, T>(st, wd, g.strides(), st.base_node, P::gather(form.alpha.data()), gamma, beta,
-                       nodal, 0, Real(1), sums);
+    scatter_rows<T>(st, g, fold(form.alpha, dt), gamma, beta, form.nodal, sums);
   }
 
   // The sums from the packed velocities (VelocityRows<Dim, T.old>::data()); with
@@ -202,37 +213,67 @@ class TensorTransfer {
   }
 
  private:
-  using Col = typename ScatterForm<Dim>::Col;
   using V = Vec<Dim>;
+  using Form = ScatterForm<Dim>;
 
-  static constexpr int N = ScatterForm<Dim>::N;
+  static constexpr int N = Form::N;
 
   using P = Row<N>;
+
+  // (m, p + dt f) of a form column, in registers.
+  MPMTB_INLINE static Row<kFoldedWidth<Dim>> fold(const typename Form::Col& c, Real dt) {
+    RowBuilder<kFoldedWidth<Dim>> r;
+    r[Form::m] = c[Form::m];
+    for (int a = 0; a < Dim; ++a) r[Form::p + a] = c[Form::p + a] + dt * c[Form::f + a];
+    return r.row();
+  }
+
+  // The scatter over rows of W values per node: alpha, gamma, beta as rows,
+  // nodal (TensorTerms::nodal) the per-node momenta that go to the p slots.
+  template <TensorTerms T, class R>
+  MPMTB_INLINE static void scatter_rows(const St& st, const GridGeometry<Dim>& g, const R& alpha,
+                                        const R (&gamma)[Dim], const R (&beta)[Dim],
+                                        const Vec<Dim>* nodal_values, Real* __restrict sums) {
+    Real wd[Dim][S];
+    for (int a = 0; a < Dim; ++a)
+      for (int k = 0; k < S; ++k) wd[a][k] = st.w[a][k] * st.d[a][k];
+    R nodal[T.nodal ? St::count : 1];
+    if constexpr (T.nodal) {
+      for (int j = 0; j < St::count; ++j) {
+        RowBuilder<R::count> row;
+        row.template segment<Dim>(Form::p) = nodal_values[j];
+        nodal[j] = row.row();
+      }
+    }
+    scatter_axis<0, T>(st, wd, g.strides(), st.base_node, alpha, gamma, beta, nodal, 0, Real(1),
+                       sums);
+  }
 
   // Top down: on entry to axis A, the node value is
   //   alpha prod_{b>=A} w_b + sum_{a>=A} gamma[a] (prod_{b>=A} w_b) d_a
   //                         + sum_{a>=A} beta[a] dw_a prod_{b>=A, b!=a} w_b;
   // j is the stencil index of the axes before A, w_before = prod_{b<A} w_b.
-  template <int A, TensorTerms T, int K>
+  template <int A, TensorTerms T, class R, int K>
   MPMTB_INLINE static inline void scatter_axis(const St& st, const Real (&wd)[Dim][S],
                                                const std::array<long, Dim>& stride, long node,
-                                               const P& alpha, const P (&gamma)[Dim],
-                                               const P (&beta)[Dim], const P (&nodal)[K], int j,
+                                               const R& alpha, const R (&gamma)[Dim],
+                                               const R (&beta)[Dim], const R (&nodal)[K], int j,
                                                Real w_before, Real* __restrict sums) {
+    constexpr int W = R::count;  // values per node
     for (int k = 0; k < S; ++k) {
       const Real w = st.w[A][k];
-      P al = w * alpha;
+      R al = w * alpha;
       if constexpr (T.moment) al.add_scaled(wd[A][k], gamma[A]);
       if constexpr (T.gradient) al.add_scaled(st.dw[A][k], beta[A]);
       const long n = node + k * stride[A];
       if constexpr (A == Dim - 1) {
         if constexpr (T.nodal) al.add_scaled(w_before * w, nodal[j * S + k]);
-        Real* out = sums + n * N;
-        P sum = P::load(out);
+        Real* out = sums + n * W;
+        R sum = R::load(out);
         sum += al;
         sum.store(out);
       } else {
-        P g2[Dim], b2[Dim];
+        R g2[Dim], b2[Dim];
         for (int a = A + 1; a < Dim; ++a) {
           if constexpr (T.moment) g2[a] = w * gamma[a];
           if constexpr (T.gradient) b2[a] = w * beta[a];

@@ -11,6 +11,7 @@
 #include "core/errors.hpp"
 #include "core/registry.hpp"
 #include "setup.hpp"
+#include "support/gaps.hpp"
 #include "support/scenes.hpp"
 
 namespace mpmtb {
@@ -40,9 +41,11 @@ TEST(Asflip, AlphaZeroIsApic) {
   const Body apic = after_steps("apic", 50);
   for (const char* transfer : {"aflip", "asflip"}) {
     const Body b = after_steps(transfer, 50, {std::string(transfer) + ".alpha=0"});
-    EXPECT_EQ(b.s.particles.x, apic.s.particles.x) << transfer;
-    EXPECT_EQ(b.s.particles.v, apic.s.particles.v) << transfer;
-    EXPECT_EQ(b.s.particles.C, apic.s.particles.C) << transfer;
+    // To round-off: AFLIP keeps v_old apart, APIC folds the force (support/gaps.hpp).
+    constexpr Real tol = testing::kReorderedSumsTolerance;
+    EXPECT_LT(testing::relative_gap(b.s.particles.x, apic.s.particles.x), tol) << transfer;
+    EXPECT_LT(testing::relative_gap(b.s.particles.v, apic.s.particles.v), tol) << transfer;
+    EXPECT_LT(testing::relative_gap(b.s.particles.C, apic.s.particles.C), tol) << transfer;
     const Body d = after_steps(transfer, 50);  // default alpha = 0.99
     EXPECT_NE(d.s.particles.v, apic.s.particles.v) << transfer;
   }

@@ -12,6 +12,7 @@
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
 #include "kernels/all.hpp"
+#include "support/gaps.hpp"
 #include "transfers/all.hpp"
 
 namespace mpmtb {
@@ -28,21 +29,7 @@ Vec<Dim> random_vector(std::mt19937& rng) {
   return Vec<Dim>::NullaryExpr([&] { return u(rng); });
 }
 
-// Largest |a - b| relative to the largest |a|, over a whole nodal or particle field.
-template <class T>
-Real relative_gap(const std::vector<T>& a, const std::vector<T>& b) {
-  Real gap = 0, scale = 0;
-  for (std::size_t i = 0; i < a.size(); ++i) {
-    if constexpr (std::is_arithmetic_v<T>) {
-      gap = std::max(gap, std::abs(a[i] - b[i]));
-      scale = std::max(scale, std::abs(a[i]));
-    } else {
-      gap = std::max(gap, (a[i] - b[i]).cwiseAbs().maxCoeff());
-      scale = std::max(scale, a[i].cwiseAbs().maxCoeff());
-    }
-  }
-  return scale > 0 ? gap / scale : gap;
-}
+using testing::relative_gap;
 
 template <int Dim, class Kernel, class Transfer>
 void check_fast_path_matches_per_node(const std::string& what, int* checked) {
@@ -93,6 +80,19 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       EXPECT_LT(relative_gap(ref.m, fast.m), 1e-14) << what << " m_i";
       EXPECT_LT(relative_gap(ref.p, fast.p), 1e-14) << what << " p_i";
       EXPECT_LT(relative_gap(ref.f, fast.f), 1e-14) << what << " f_i";
+      // The same with the force folded into the momentum: (m_i, p_i + dt f_i).
+      const Real dt = 0.3;
+      NodeSums<Dim, true> folded;
+      folded.resize(fast.size());
+      TensorTransfer<Dim, Kernel>::template scatter_folded<Policy::scatter_terms>(st, geo, form, dt,
+                                                                                  folded.data());
+      Grid<Dim> fold(geo);
+      folded.template unpack<true, true>(0, static_cast<long>(fold.size()), fold.m.data(),
+                                         fold.p.data(), fold.f.data());
+      std::vector<Vec<Dim>> p_dt_f(ref.size());
+      for (std::size_t n = 0; n < ref.size(); ++n) p_dt_f[n] = ref.p[n] + dt * ref.f[n];
+      EXPECT_LT(relative_gap(ref.m, fold.m), 1e-14) << what << " folded m_i";
+      EXPECT_LT(relative_gap(p_dt_f, fold.p), 1e-14) << what << " folded p_i + dt f_i";
 
       // G2P from a random velocity field: v_p, C_p, F_p, x_p.
       for (std::size_t n = 0; n < ref.size(); ++n) {

@@ -8,6 +8,7 @@
 #include "core/errors.hpp"
 #include "setup.hpp"
 #include "support/combinations.hpp"
+#include "support/gaps.hpp"
 #include "support/scenes.hpp"
 
 namespace mpmtb {
@@ -168,8 +169,10 @@ std::vector<Vec<Dim>> positions_after(const std::string& transfer, const std::st
 }
 
 TEST(TransferIdentities, FlipWithAlphaZeroIsPic) {
-  EXPECT_EQ(positions_after<2>("flip", "quadratic", {"flip.alpha=0"}),
-            positions_after<2>("pic", "quadratic"));
+  // To round-off: FLIP keeps v_old apart, PIC folds the force (support/gaps.hpp).
+  EXPECT_LT(testing::relative_gap(positions_after<2>("flip", "quadratic", {"flip.alpha=0"}),
+                                  positions_after<2>("pic", "quadratic")),
+            testing::kReorderedSumsTolerance);
   EXPECT_NE(positions_after<2>("flip", "quadratic", {"flip.alpha=1"}),
             positions_after<2>("pic", "quadratic"));
 }

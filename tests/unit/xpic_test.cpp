@@ -14,6 +14,7 @@
 #include "core/errors.hpp"
 #include "core/registry.hpp"
 #include "setup.hpp"
+#include "support/gaps.hpp"
 #include "support/scenes.hpp"
 
 namespace mpmtb {
@@ -50,8 +51,9 @@ Outcome free_body(const std::string& transfer, const std::vector<std::string>& s
 // v* = sum_k (-1)^{k+1} C(1,k) S+ P^{k-1} v_p = S+ v_p = v^n: the update is S v^{n+1}.
 TEST(Xpic, OrderOneIsPic) {
   const Outcome pic = free_body("pic"), xpic1 = free_body("xpic", {"xpic.m=1"});
-  EXPECT_EQ(xpic1.x, pic.x);
-  EXPECT_EQ(xpic1.v, pic.v);
+  // To round-off: XPIC keeps v_old apart, PIC folds the force (support/gaps.hpp).
+  EXPECT_LT(testing::relative_gap(xpic1.x, pic.x), testing::kReorderedSumsTolerance);
+  EXPECT_LT(testing::relative_gap(xpic1.v, pic.v), testing::kReorderedSumsTolerance);
   const Outcome xpic2 = free_body("xpic", {"xpic.m=2"});
   EXPECT_NE(xpic2.v, pic.v) << "m = 2 must keep some of the particle velocity";
 }
@@ -67,7 +69,8 @@ TEST(Xpic, EnergyKeptGrowsWithOrderTowardFlip) {
   for (int m : {1, 2, 4, 8}) {
     const Real kept = disks("xpic", {"xpic.m=" + std::to_string(m)});
     if (m == 1) {
-      EXPECT_EQ(kept, pic);
+      // The whole collision (thousands of steps) from sums in another order.
+      EXPECT_NEAR(kept, pic, 1e-9 * pic);
     } else {
       EXPECT_GT(kept, previous) << "m = " << m;
     }
