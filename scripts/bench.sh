@@ -108,5 +108,37 @@ fi
 cp "$rows" "$out.tmp" && mv "$out.tmp" "$out"
 echo "bench: wrote $out"
 column -s, -t "$out"
+# Each transfer x kernel's cost per particle-step relative to MLS-MPM with the
+# quadratic B-spline in the same dimension (rate of mls-quadratic / own rate).
+if grep -q ',transfers,' "$out"; then
+  rel=results/bench/transfers_relative.csv
+  awk -F, 'NR > 1 && $9 == "transfers" {
+             key = $1 "," $2 "," $3; rate[key] = $7; order[++n] = key
+             if ($2 == "mls" && $3 == "quadratic") ref[$1] = $7 }
+           END { print "dim,transfer,kernel,particle_steps_per_second,cost_vs_mls_quadratic"
+                 for (i = 1; i <= n; ++i) { split(order[i], f, ",")
+                   printf "%s,%.0f,%.2f\n", order[i], rate[order[i]],
+                          (f[1] in ref) ? ref[f[1]] / rate[order[i]] : 0 } }' "$out" >"$rel.tmp"
+  mv "$rel.tmp" "$rel"
+  echo "bench: wrote $rel"
+fi
+# Side by side with the fused yardsticks (../shared/bench, built with -O3
+# -march=native): medians of REPEATS interleaved rounds and mpmtb / yardstick.
+yardstick=../shared/bench/yardstick.sh
+if [ -f "$yardstick" ]; then
+  yard=results/bench/yardstick.csv
+  MPMTB=build/cases/mpmtb MPMTB_FLOAT=build-float/cases/mpmtb R="$REPEATS" bash "$yardstick" \
+    | tee "$tmp/yardstick.txt"
+  load=$(sed -n 's/.*load \([0-9.]*\)).*/\1/p' "$tmp/yardstick.txt")
+  { echo "configuration,yardstick,mpmtb,ratio,rounds,load_1min"
+    awk -v r="$REPEATS" -v l="$load" '$1 ~ /^[23]d$/ && NF >= 6 {
+      name = $1; for (k = 2; k <= NF - 3; ++k) name = name " " $k
+      printf "%s,%s,%s,%s,%s,%s\n", name, $(NF - 2), $(NF - 1), $NF, r, l }' \
+      "$tmp/yardstick.txt"; } >"$yard.tmp"
+  mv "$yard.tmp" "$yard"
+  echo "bench: wrote $yard"
+else
+  echo "bench: $yardstick not found; the yardstick ratios were not measured" >&2
+fi
 # Figures next to the table: targets.png, scaling.png, transfers.png.
 /usr/bin/python3 analysis/bench_plots.py "$out"
