@@ -12,6 +12,7 @@
 #include "core/registry.hpp"
 #include "models/registry.hpp"
 #include "suite/suite.hpp"
+#include "version.hpp"
 
 #ifndef MPMTB_SOURCE_DIR
 #define MPMTB_SOURCE_DIR "."
@@ -115,6 +116,8 @@ int main(int argc, char** argv) {
       "series.csv and summary.json; see `mpmtb list` and `mpmtb <command> --help`.\n"
       "Exit status: 0 ok, 1 program error, 2 invalid input, 3 unstable run."};
   app.require_subcommand(1);
+  // Version, git revision and the flags that decide the floating-point results.
+  app.set_version_flag("--version", mpmtb::version_text(), "print the version and build flags");
 
   std::string list_only;
   auto* list = app.add_subcommand(
