@@ -142,6 +142,10 @@ int main(int argc, char** argv) {
   list->add_option("what", list_only,
                    "print only the names of one group: transfers|kernels|models|scenes")
       ->check(CLI::IsMember({"transfers", "kernels", "models", "scenes"}));
+  bool list_bibtex = false;
+  list->add_flag("--bibtex", list_bibtex,
+                 "print the BibTeX of the papers behind every registered transfer, kernel and "
+                 "model, each entry once with the variants it backs");
 
   mpmtb::RunRequest run_request;
   auto* run = app.add_subcommand(
@@ -211,7 +215,7 @@ int main(int argc, char** argv) {
     return mpmtb::kExitInvalid;
   }
   try {
-    if (*list) return mpmtb::command_list(list_only);
+    if (*list) return mpmtb::command_list(list_only, list_bibtex);
     if (*describe) return mpmtb::command_describe(describe_scene, describe_overrides);
     if (*suite) return mpmtb::command_suite(suite_request);
     if (*compare) return mpmtb::compare::command_compare(compare_request);
