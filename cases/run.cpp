@@ -15,14 +15,8 @@
 #include "progress.hpp"
 #include "references/reference.hpp"
 #include "setup.hpp"
+#include "version.hpp"
 #include "vtk/frames.hpp"
-
-#ifndef MPMTB_GIT_REV
-#define MPMTB_GIT_REV "unknown"
-#endif
-#ifndef MPMTB_BUILD_TYPE
-#define MPMTB_BUILD_TYPE "unknown"
-#endif
 
 namespace mpmtb {
 namespace {
@@ -159,8 +153,9 @@ nlohmann::json base_summary(const Scene& scene) {
   j["t_end"] = scene.t_end;
   if (scene.cfl) j["cfl"] = *scene.cfl;
   if (scene.dt) j["dt"] = *scene.dt;
-  j["git_revision"] = MPMTB_GIT_REV;
-  j["build_type"] = MPMTB_BUILD_TYPE;
+  j["git_revision"] = build_info().git_revision;
+  j["build_type"] = build_info().build_type;
+  j["version"] = version_json();
   j["config"] = toml_to_json(scene.resolved);
   return j;
 }
@@ -356,6 +351,7 @@ RunOutcome write_invalid(const std::filesystem::path& out_dir, const std::string
   nlohmann::json j = context;
   j["status"] = "invalid";
   j["reason"] = reason;
+  j["version"] = version_json();
   write_atomically(out_dir / "summary.json", dump_json(j));
   return {"invalid", reason, j};
 }

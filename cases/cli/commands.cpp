@@ -7,6 +7,7 @@
 #include <iostream>
 #include <set>
 
+#include "citations.hpp"
 #include "core/errors.hpp"
 #include "core/registry.hpp"
 #include "models/registry.hpp"
@@ -79,7 +80,11 @@ int exit_status(const std::string& status) {
 
 }  // namespace
 
-int command_list(const std::string& only) {
+int command_list(const std::string& only, bool bibtex) {
+  if (bibtex) {
+    fmt::print("{}", bibtex_listing());
+    return kExitOk;
+  }
   auto section = [&](const char* title, const char* how, const auto& items) {
     if (!only.empty() && only != title) return;
     if (only.empty()) fmt::print("{} ({}):\n", title, how);

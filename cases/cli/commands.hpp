@@ -20,7 +20,8 @@ struct RunRequest {
   bool quiet = false;  // no progress line and no per-run status lines
 };
 
-int command_list(const std::string& only);
+// `only`: the names of one group; `bibtex`: the papers behind the variants instead.
+int command_list(const std::string& only, bool bibtex = false);
 // The scene's effective parameters (defaults included) after overrides, then its TOML.
 int command_describe(const std::string& scene, const Overrides& overrides);
 // Runs one scene, or, with --transfer all and/or --kernel all, every

@@ -8,10 +8,12 @@
 
 #include "boundary/walls.hpp"
 #include "commands.hpp"
+#include "compare/compare.hpp"
 #include "core/errors.hpp"
 #include "core/registry.hpp"
 #include "models/registry.hpp"
 #include "suite/suite.hpp"
+#include "version.hpp"
 
 #ifndef MPMTB_SOURCE_DIR
 #define MPMTB_SOURCE_DIR "."
@@ -93,6 +95,22 @@ CLI::App* add_suite_command(CLI::App& app, mpmtb::SuiteRequest& r) {
   return cmd;
 }
 
+// `mpmtb compare OLD NEW`: results trees metric by metric (cases/compare/).
+CLI::App* add_compare_command(CLI::App& app, mpmtb::compare::CompareRequest& r) {
+  auto* cmd = app.add_subcommand(
+      "compare",
+      "compare two results trees (summary.json, runs.csv, suite tables) metric by metric; exit "
+      "status 0 when nothing changed beyond tolerance, 1 when something did, 2 for bad input");
+  cmd->add_option("old", r.old_root, "the reference tree (or file), e.g. results/baseline")
+      ->required();
+  cmd->add_option("new", r.new_root, "the tree (or file) to check")->required();
+  cmd->add_option("--tolerances", r.tolerances,
+                  "tolerance file (TOML; default: the built-in cases/compare/tolerances.toml)");
+  cmd->add_option("--limit", r.limit, "rows of the table of changes to print, 0: all")
+      ->capture_default_str();
+  return cmd;
+}
+
 // A message on one line: control characters from user strings are escaped.
 std::string one_line(const std::string& text) {
   std::string out;
@@ -115,6 +133,8 @@ int main(int argc, char** argv) {
       "series.csv and summary.json; see `mpmtb list` and `mpmtb <command> --help`.\n"
       "Exit status: 0 ok, 1 program error, 2 invalid input, 3 unstable run."};
   app.require_subcommand(1);
+  // Version, git revision and the flags that decide the floating-point results.
+  app.set_version_flag("--version", mpmtb::version_text(), "print the version and build flags");
 
   std::string list_only;
   auto* list = app.add_subcommand(
@@ -122,6 +142,10 @@ int main(int argc, char** argv) {
   list->add_option("what", list_only,
                    "print only the names of one group: transfers|kernels|models|scenes")
       ->check(CLI::IsMember({"transfers", "kernels", "models", "scenes"}));
+  bool list_bibtex = false;
+  list->add_flag("--bibtex", list_bibtex,
+                 "print the BibTeX of the papers behind every registered transfer, kernel and "
+                 "model, each entry once with the variants it backs");
 
   mpmtb::RunRequest run_request;
   auto* run = app.add_subcommand(
@@ -171,6 +195,8 @@ int main(int argc, char** argv) {
 
   mpmtb::SuiteRequest suite_request;
   auto* suite = add_suite_command(app, suite_request);
+  mpmtb::compare::CompareRequest compare_request;
+  auto* compare = add_compare_command(app, compare_request);
   std::vector<std::string> render_args;
   auto* render = app.add_subcommand(
       "render",
@@ -189,9 +215,10 @@ int main(int argc, char** argv) {
     return mpmtb::kExitInvalid;
   }
   try {
-    if (*list) return mpmtb::command_list(list_only);
+    if (*list) return mpmtb::command_list(list_only, list_bibtex);
     if (*describe) return mpmtb::command_describe(describe_scene, describe_overrides);
     if (*suite) return mpmtb::command_suite(suite_request);
+    if (*compare) return mpmtb::compare::command_compare(compare_request);
     if (*render) return forward_to_render(render->remaining());
     if (run_request.scene.empty() && run_request.config.empty()) {
       throw mpmtb::InputError("run: give a scene (name or file) or --config DIR/summary.json");

@@ -16,6 +16,7 @@
 #include <thread>
 
 #include "output.hpp"
+#include "version.hpp"
 
 namespace mpmtb::suite {
 namespace {
@@ -24,11 +25,6 @@ namespace fs = std::filesystem;
 using Clock = std::chrono::steady_clock;
 
 constexpr const char* kMarker = "done.json";
-#ifdef MPMTB_GIT_REV
-constexpr const char* kRevision = MPMTB_GIT_REV;
-#else
-constexpr const char* kRevision = "unknown";
-#endif
 
 volatile std::sig_atomic_t g_stop = 0;
 extern "C" void on_stop_signal(int) {
@@ -178,7 +174,7 @@ RunResult settle(const RunSpec& spec, const fs::path& dir, int wait_status, bool
   const int code = exited ? WEXITSTATUS(wait_status) : -1;
   nlohmann::json marker;
   marker["arguments"] = spec.arguments(dir);
-  marker["revision"] = kRevision;
+  marker["revision"] = build_info().git_revision;
   marker["seconds"] = seconds;
   if (exited) {
     marker["exit_code"] = code;
@@ -227,7 +223,7 @@ std::optional<RunResult> finished(const RunSpec& spec, const fs::path& dir) {
   auto marker = read_json(dir / kMarker);
   if (!marker || !marker->contains("status")) return std::nullopt;
   if (marker->value("arguments", nlohmann::json()) != nlohmann::json(spec.arguments(dir)) ||
-      marker->value("revision", "") != kRevision) {
+      marker->value("revision", "") != build_info().git_revision) {
     return std::nullopt;
   }
   auto summary = read_json(dir / "summary.json");

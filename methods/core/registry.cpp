@@ -14,7 +14,7 @@ template <class List>
 std::vector<VariantInfo> infos() {
   std::vector<VariantInfo> out;
   List::for_each([&]<class T>() {
-    out.push_back({std::string(T::name), std::string(T::description)});
+    out.push_back({std::string(T::name), std::string(T::description), std::string(T::bibtex)});
   });
   return out;
 }

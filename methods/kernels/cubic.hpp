@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "core/papers.hpp"
 #include "core/types.hpp"
 
 namespace mpmtb {
@@ -12,6 +13,7 @@ struct CubicKernel {
   static constexpr std::string_view name = "cubic";
   static constexpr std::string_view description =
       "cubic B-spline, 4 nodes per axis, C2 (D_p = dx^2/3 I)";
+  static constexpr std::string_view bibtex = papers::steffen2008;  // mpmtb list --bibtex
   static constexpr int support = 4;
   // D_p = (n + 1) dx^2 / 12 for a B-spline of degree n: dx^2 / 3 here.
   static constexpr bool constant_inertia = true;

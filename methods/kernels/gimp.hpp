@@ -25,6 +25,16 @@ struct GimpKernel {
   static constexpr std::string_view description =
       "uniform GIMP (Bardenhagen & Kober 2004), particle half-width l = 1/(2 ppc), 3 nodes per "
       "axis, C1 (D_p per particle)";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{bardenhagen2004,
+  author = {Bardenhagen, Scott G. and Kober, Edward M.},
+  title = {The generalized interpolation material point method},
+  journal = {Computer Modeling in Engineering and Sciences},
+  volume = {5},
+  number = {6},
+  pages = {477--495},
+  year = {2004}
+})bib";
   static constexpr int support = 3;
   static constexpr bool constant_inertia = false;
   static constexpr Real inertia = 0;

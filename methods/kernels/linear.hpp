@@ -4,6 +4,7 @@
 #include <cmath>
 #include <string_view>
 
+#include "core/papers.hpp"
 #include "core/types.hpp"
 
 namespace mpmtb {
@@ -12,6 +13,7 @@ struct LinearKernel {
   static constexpr std::string_view name = "linear";
   static constexpr std::string_view description =
       "linear hat, 2 nodes per axis, C0 gradients (cell-crossing noise)";
+  static constexpr std::string_view bibtex = papers::sulsky1994;  // mpmtb list --bibtex
   static constexpr int support = 2;
   // D_p = sum_i w_ip (x_i - x_p)(x_i - x_p)^T is diag(f (1 - f)) dx^2 for the hat,
   // f the position inside the cell: singular at nodes, so no constant inertia.

@@ -75,6 +75,23 @@ template <int Dim>
 class Damage final : public ModelBase<Dim, Damage<Dim>> {
  public:
   static constexpr std::string_view model_name = "damage";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{wolper2019,
+  author = {Wolper, Joshuah and Fang, Yu and Li, Minchen and Lu, Jiecong and Gao, Ming and Jiang, Chenfanfu},
+  title = {{CD-MPM}: continuum damage material point methods for dynamic fracture animation},
+  journal = {ACM Transactions on Graphics},
+  volume = {38},
+  number = {4},
+  year = {2019}
+}
+@article{wolper2020,
+  author = {Wolper, Joshuah and Chen, Yunuo and Li, Minchen and Fang, Yu and Qu, Ziyin and Lu, Jiecong and Cheng, Meggie and Jiang, Chenfanfu},
+  title = {{AnisoMPM}: animating anisotropic damage mechanics},
+  journal = {ACM Transactions on Graphics},
+  volume = {39},
+  number = {4},
+  year = {2020}
+})bib";
   enum StateIndex { kDamage = 0, kDissipated = 1, kLapDamage = 2, kLapDiagonal = 3 };
 
   explicit Damage(Parameters& params)

@@ -40,6 +40,14 @@ template <int Dim>
 class FixedCorotated final : public ModelBase<Dim, FixedCorotated<Dim>> {
  public:
   static constexpr std::string_view model_name = "fixed-corotated";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@inproceedings{stomakhin2012,
+  author = {Stomakhin, Alexey and Howes, Russell and Schroeder, Craig and Teran, Joseph M.},
+  title = {Energetically consistent invertible elasticity},
+  booktitle = {Proceedings of the ACM SIGGRAPH/Eurographics Symposium on Computer Animation},
+  pages = {25--32},
+  year = {2012}
+})bib";
 
   explicit FixedCorotated(Parameters& params) : c_(ElasticConstants::read(params)) {}
 

@@ -11,6 +11,7 @@
 // model conformance test names it as the documented exception.
 #pragma once
 
+#include "core/papers.hpp"
 #include "models/lame.hpp"
 #include "models/model.hpp"
 
@@ -20,6 +21,7 @@ template <int Dim>
 class LinearElastic final : public ModelBase<Dim, LinearElastic<Dim>> {
  public:
   static constexpr std::string_view model_name = "linear-elastic";
+  static constexpr std::string_view bibtex = papers::sulsky1994;  // mpmtb list --bibtex
 
   explicit LinearElastic(Parameters& params) : c_(ElasticConstants::read(params)) {}
 

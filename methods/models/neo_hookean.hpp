@@ -18,6 +18,14 @@ template <int Dim>
 class NeoHookean final : public ModelBase<Dim, NeoHookean<Dim>> {
  public:
   static constexpr std::string_view model_name = "neo-hookean";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@book{bonet2008,
+  author = {Bonet, Javier and Wood, Richard D.},
+  title = {Nonlinear Continuum Mechanics for Finite Element Analysis},
+  edition = {2nd},
+  publisher = {Cambridge University Press},
+  year = {2008}
+})bib";
 
   explicit NeoHookean(Parameters& params) : c_(ElasticConstants::read(params)) {}
 

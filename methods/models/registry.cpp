@@ -22,10 +22,11 @@ struct ModelEntry {
 
 template <template <int> class Model>
 ModelEntry entry(std::string description) {
-  return {{std::string(Model<1>::model_name), std::move(description)},
-          [](Parameters& p) { return std::make_unique<Model<1>>(p); },
-          [](Parameters& p) { return std::make_unique<Model<2>>(p); },
-          [](Parameters& p) { return std::make_unique<Model<3>>(p); }};
+  return {
+      {std::string(Model<1>::model_name), std::move(description), std::string(Model<1>::bibtex)},
+      [](Parameters& p) { return std::make_unique<Model<1>>(p); },
+      [](Parameters& p) { return std::make_unique<Model<2>>(p); },
+      [](Parameters& p) { return std::make_unique<Model<3>>(p); }};
 }
 
 // One line per model, in the order `mpmtb list` shows them (methods/README.md).

@@ -14,6 +14,7 @@ namespace mpmtb {
 struct ModelInfo {
   std::string name;
   std::string description;
+  std::string bibtex = {};  // the papers behind it (BibTeX entries), from its header
 };
 
 const std::vector<ModelInfo>& model_list();

@@ -66,6 +66,17 @@ template <int Dim>
 class Sand final : public ModelBase<Dim, Sand<Dim>> {
  public:
   static constexpr std::string_view model_name = "sand";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{klar2016,
+  author = {Klar, Gergely and Gast, Theodore and Pradhana, Andre and Fu, Chuyuan and Schroeder, Craig and Jiang, Chenfanfu and Teran, Joseph},
+  title = {Drucker-Prager elastoplasticity for sand animation},
+  journal = {ACM Transactions on Graphics},
+  volume = {35},
+  number = {4},
+  articleno = {103},
+  year = {2016},
+  doi = {10.1145/2897824.2925906}
+})bib";
   enum StateIndex { kJP = 0, kHardening = 1, kDissipated = 2 };
 
   explicit Sand(Parameters& params)

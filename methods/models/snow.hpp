@@ -1,4 +1,4 @@
-// Snow: elastoplasticity of Stomakhin, Schroeder, Chai, Chu & Teran 2013,
+// Snow: elastoplasticity of Stomakhin, Schroeder, Chai, Teran & Selle 2013,
 // "A material point method for snow simulation", ACM Trans. Graph. 32(4)
 // (SIGGRAPH), sec. 5-6. F = F_E F_P; the particle's F is the elastic part F_E
 // and the plastic part enters only through J_P = det F_P.
@@ -55,6 +55,17 @@ template <int Dim>
 class Snow final : public ModelBase<Dim, Snow<Dim>> {
  public:
   static constexpr std::string_view model_name = "snow";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{stomakhin2013,
+  author = {Stomakhin, Alexey and Schroeder, Craig and Chai, Lawrence and Teran, Joseph and Selle, Andrew},
+  title = {A material point method for snow simulation},
+  journal = {ACM Transactions on Graphics},
+  volume = {32},
+  number = {4},
+  articleno = {102},
+  year = {2013},
+  doi = {10.1145/2461912.2461948}
+})bib";
   enum StateIndex { kJP = 0, kDissipated = 1 };
 
   explicit Snow(Parameters& params)

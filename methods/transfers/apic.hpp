@@ -110,6 +110,17 @@ struct ApicTransfer {
   static constexpr std::string_view description =
       "APIC: affine momentum C_p, kernel-gradient force and F (Jiang et al. 2015); "
       "linear: C_p = sum v_i grad w^T; gimp: the particle's own D_p";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{jiang2015,
+  author = {Jiang, Chenfanfu and Schroeder, Craig and Selle, Andrew and Teran, Joseph and Stomakhin, Alexey},
+  title = {The affine particle-in-cell method},
+  journal = {ACM Transactions on Graphics},
+  volume = {34},
+  number = {4},
+  articleno = {51},
+  year = {2015},
+  doi = {10.1145/2766996}
+})bib";
   static constexpr bool affine_momentum = true;
   // Whether the paper claims angular momentum conservation, affine part included, in both
   // transfers (if so, the conformance tests hold it to round-off).

@@ -101,6 +101,17 @@ struct AflipTransfer {
   static constexpr std::string_view description =
       "AFLIP: APIC with the FLIP velocity increment blended in by aflip.alpha (default 0.99; "
       "Fei et al. 2021); alpha = 0 is APIC";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{fei2021,
+  author = {Fei, Yun (Raymond) and Guo, Qi and Wu, Rundong and Huang, Li and Gao, Ming},
+  title = {Revisiting integration in the material point method: a scheme for easier separation and less dissipation},
+  journal = {ACM Transactions on Graphics},
+  volume = {40},
+  number = {4},
+  articleno = {109},
+  year = {2021},
+  doi = {10.1145/3450626.3459678}
+})bib";
   static constexpr bool affine_momentum = true;
   // Whether the paper claims angular momentum conservation, affine part included, in both
   // transfers (if so, the conformance tests hold it to round-off).
@@ -118,6 +129,7 @@ struct AsflipTransfer {
   static constexpr std::string_view description =
       "ASFLIP: AFLIP whose separating particles also move by beta x the FLIP increment "
       "(Fei et al. 2021); asflip.alpha 0.99, beta_min 0, beta_max 1";
+  static constexpr std::string_view bibtex = AflipTransfer::bibtex;  // the same paper
   static constexpr bool affine_momentum = true;
   // Whether the paper claims angular momentum conservation, affine part included, in both
   // transfers (if so, the conformance tests hold it to round-off).

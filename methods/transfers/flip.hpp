@@ -52,6 +52,17 @@ struct FlipTransfer {
   static constexpr std::string_view name = "flip";
   static constexpr std::string_view description =
       "FLIP(alpha): grid velocity increments, blended with PIC by flip.alpha (default 1)";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{brackbill1986,
+  author = {Brackbill, Jeremiah U. and Ruppel, Hans M.},
+  title = {{FLIP}: A method for adaptively zoned, particle-in-cell calculations of fluid flows in two dimensions},
+  journal = {Journal of Computational Physics},
+  volume = {65},
+  number = {2},
+  pages = {314--343},
+  year = {1986},
+  doi = {10.1016/0021-9991(86)90211-1}
+})bib";
   static constexpr bool affine_momentum = false;
   // Whether the paper claims angular momentum conservation, affine part included, in both
   // transfers (if so, the conformance tests hold it to round-off).

@@ -86,6 +86,17 @@ struct MlsTransfer {
   static constexpr std::string_view description =
       "MLS-MPM: APIC with the MLS force and F from C (Hu et al. 2018); linear: gradient form; "
       "gimp: the particle's own D_p";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{hu2018,
+  author = {Hu, Yuanming and Fang, Yu and Ge, Ziheng and Qu, Ziyin and Zhu, Yixin and Pradhana, Andre and Jiang, Chenfanfu},
+  title = {A moving least squares material point method with displacement discontinuity and two-way rigid body coupling},
+  journal = {ACM Transactions on Graphics},
+  volume = {37},
+  number = {4},
+  articleno = {150},
+  year = {2018},
+  doi = {10.1145/3197517.3201293}
+})bib";
   static constexpr bool affine_momentum = true;
   // Whether the paper claims angular momentum conservation, affine part included, in both
   // transfers (if so, the conformance tests hold it to round-off).

@@ -10,6 +10,7 @@
 
 #include <string_view>
 
+#include "core/papers.hpp"
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
 #include "core/tensor_transfer.hpp"
@@ -71,6 +72,7 @@ struct PicTransfer {
   static constexpr std::string_view name = "pic";
   static constexpr std::string_view description =
       "PIC: particle velocity replaced by the grid's (Sulsky et al. 1994); dissipative";
+  static constexpr std::string_view bibtex = papers::sulsky1994;  // mpmtb list --bibtex
   static constexpr bool affine_momentum = false;
   // Whether the paper claims angular momentum conservation, affine part included, in both
   // transfers (if so, the conformance tests hold it to round-off).

@@ -266,6 +266,17 @@ struct PolypicTransfer {
   static constexpr std::string_view description =
       "PolyPIC: per-particle polynomial velocity in all S^Dim stencil modes, orthogonal "
       "under the weights (Fu et al. 2017); kernel-gradient force and F";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{fu2017,
+  author = {Fu, Chuyuan and Guo, Qi and Gast, Theodore and Jiang, Chenfanfu and Teran, Joseph},
+  title = {A polynomial particle-in-cell method},
+  journal = {ACM Transactions on Graphics},
+  volume = {36},
+  number = {6},
+  articleno = {222},
+  year = {2017},
+  doi = {10.1145/3130800.3130878}
+})bib";
   // P.C holds the linear modes (APIC's C_p), so the diagnostics count the affine
   // angular momentum; the higher modes carry none.
   static constexpr bool affine_momentum = true;

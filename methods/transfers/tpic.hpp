@@ -44,6 +44,16 @@ struct TpicTransfer {
   static constexpr std::string_view description =
       "TPIC: Taylor PIC, P2G with the velocity gradient C_p = sum v_i grad w^T "
       "(Nakamura et al. 2023); APIC with the linear hat";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{nakamura2023,
+  author = {Nakamura, Keita and Matsumura and Mizutani},
+  title = {Taylor particle-in-cell transfer and kernel correction for material point method},
+  journal = {Computer Methods in Applied Mechanics and Engineering},
+  volume = {403},
+  pages = {115720},
+  year = {2023},
+  doi = {10.1016/j.cma.2022.115720}
+})bib";
   static constexpr bool affine_momentum = true;
   // Not claimed: the G2P gradient is not B_p D_p^-1 for B-splines (see above).
   static constexpr bool conserves_angular_momentum = false;

@@ -84,6 +84,16 @@ struct XpicTransfer {
   static constexpr std::string_view description =
       "XPIC(m): PIC with the first m terms of FLIP's grid projection series "
       "(Hammerquist & Nairn 2017); xpic.m (default 5), m = 1 is PIC";
+  // The paper behind it, BibTeX for `mpmtb list --bibtex`.
+  static constexpr std::string_view bibtex = R"bib(@article{hammerquist2017,
+  author = {Hammerquist, Chad C. and Nairn, John A.},
+  title = {A new method for material point method particle updates that reduces noise and enhances stability},
+  journal = {Computer Methods in Applied Mechanics and Engineering},
+  volume = {318},
+  pages = {724--738},
+  year = {2017},
+  doi = {10.1016/j.cma.2017.01.035}
+})bib";
   static constexpr bool affine_momentum = false;
   // Whether the paper claims angular momentum conservation, affine part included, in both
   // transfers (if so, the conformance tests hold it to round-off).
