@@ -16,7 +16,7 @@ struct VariantInfo {
   std::string name;
   std::string description;
   std::string bibtex = {};  // the papers behind it (BibTeX entries), from its header
-  bool affine = false;  // transfers: P2G carries C_p, so L includes the affine part
+  bool affine = false;      // transfers: P2G carries C_p, so L includes the affine part
   bool conserves_angular_momentum = false;  // transfers: claimed, and tested to round-off
   // Transfers: sum m_p x_p advances by dt sum m_i v_i, so the centre of mass
   // moves with the momentum (false for ASFLIP's per-particle position correction).
