@@ -128,7 +128,7 @@ struct Row {
 };
 
 // A Row built lane by lane, with the Eigen-like setters the transfers write
-// their P2G form with (col[i] = x, col.segment<K>(i) = vector, +=). The lanes
+// their P2G form with (col[i] = x, col.segment<K>(i) = or += vector). The lanes
 // are set in registers: a column written to memory piecewise and then read as
 // whole registers would stall on store forwarding (the loads span several
 // narrower stores), which the profile showed as the costliest part of P2G's
@@ -137,8 +137,6 @@ template <int N>
 class RowBuilder {
  public:
   MPMTB_INLINE RowBuilder() : row_(Row<N>::zero()) {}
-  MPMTB_INLINE static RowBuilder Zero() { return {}; }
-  MPMTB_INLINE void setZero() { row_ = Row<N>::zero(); }
   MPMTB_INLINE const Row<N>& row() const { return row_; }
   MPMTB_INLINE Real operator[](int i) const { return row_.v[i / lanes][i % lanes]; }
 
@@ -149,11 +147,6 @@ class RowBuilder {
       c_.set(i_, x);
       return *this;
     }
-    MPMTB_INLINE Lane& operator+=(Real x) {
-      c_.set(i_, std::as_const(c_)[i_] + x);
-      return *this;
-    }
-    MPMTB_INLINE operator Real() const { return std::as_const(c_)[i_]; }
 
    private:
     RowBuilder& c_;

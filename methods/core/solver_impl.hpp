@@ -85,6 +85,8 @@ class Solver final : public Stepper<Dim> {
           const Vec<Dim> v_old = g.p[i] * inv_m;
           if constexpr (Transfer::needs_old_velocity) g.v_old[i] = v_old;
           // Symplectic Euler: v_i^{n+1} = v_i^n + dt f_i / m_i (f_i includes m_i g).
+          // With folded sums (kFoldForce) p_i already holds dt times the internal
+          // and body forces, and f_i is gravity alone; v_old is then not kept.
           g.v[i] = v_old + dt * inv_m * g.f[i];
           if (g.pinned[i]) {
             const Vec3 reaction = to3<Dim>(-g.m[i] * g.v[i]);

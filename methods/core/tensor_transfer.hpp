@@ -67,7 +67,6 @@ inline constexpr int kFoldedWidth = std::max<int>(Dim == 1 ? 2 : 4,
 // same symplectic Euler step, with half the row to scatter and unpack.
 template <int Dim, bool kFolded = false>
 struct NodeSums {
-  static constexpr bool folded = kFolded;
   static constexpr int N = kFolded ? kFoldedWidth<Dim> : ScatterForm<Dim>::N;
   using Form = ScatterForm<Dim>;
   std::vector<Real> values;  // N per node, node-major
