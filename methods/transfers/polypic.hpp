@@ -39,50 +39,73 @@ namespace mpmtb {
 template <int Dim, int S>
 struct PolyModes {
   static constexpr int count = ipow(S, Dim);  // modes = stencil nodes
+  // Dim Reals padded to a whole SIMD row (core/pack.hpp): one lane per axis in
+  // build(), one row per node in the transform.
+  static constexpr int kPad = [] {
+    constexpr int lanes = 16 / int(sizeof(Real));  // the narrowest Row
+    return (Dim + lanes - 1) / lanes * lanes;
+  }();
+  using Node = Row<kPad>;
 
-  Real e[Dim][S][S];  // e[a][n][k]: e_n at node k of axis a
-  Real norm[Dim][S];  // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
-  Real d0[Dim];       // offset of node 0 per axis
+  Real e[Dim][S][S];     // e[a][n][k]: e_n at node k of axis a
+  Real norm[Dim][S];     // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
+  Real unit[Dim][S][S];  // e_n / sqrt(norm) for n >= 1 (0 if dropped), e_0 = 1 (norm 1)
+  Real root_norm[Dim];   // sqrt(norm[a][1]): e_1 = root_norm unit_1
+  Real d0[Dim];          // offset of node 0 per axis
   Real inv_dx;
 
   // Gram-Schmidt of the monomials 1, u, u^2, ... under the weights, twice over
   // ("twice is enough"): orthogonal to round-off relative to each e_n's own size,
-  // so the higher modes add no momentum beyond round-off. A mode whose norm falls
-  // below a relative tolerance of its monomial's is degenerate (fewer weighted
-  // nodes than modes, e.g. the linear hat at a node, or the quadratic B-spline
-  // half-way between nodes): it and every higher one are dropped.
+  // so the higher modes add no momentum beyond round-off. (Stieltjes' three-term
+  // recurrence, cheaper, left the cubic B-spline's e_3 visibly non-orthogonal to
+  // 1 where an end weight is tiny: a rigid translation then made strain.) A mode
+  // whose norm falls below a relative tolerance of its monomial's is degenerate
+  // (fewer weighted nodes than modes, e.g. the linear hat at a node, or the
+  // quadratic B-spline half-way between nodes): it and every higher one are dropped.
+  // The axes are independent: each runs in one SIMD lane (padding lanes have
+  // zero weights, so their modes are dropped and never read).
   template <class Kernel>
   void build(const Stencil<Dim, Kernel>& st, Real dx) {
     static_assert(Kernel::support == S);
+    using Lanes = typename PackOf<kPad * sizeof(Real)>::type;
     inv_dx = 1 / dx;
-    const Real tol = 1000 * std::numeric_limits<Real>::epsilon();
-    for (int a = 0; a < Dim; ++a) {
-      d0[a] = st.d[a][0];
-      Real u[S], power[S];
-      for (int k = 0; k < S; ++k) u[k] = st.d[a][k] * inv_dx, power[k] = 1;
-      bool dropped = false;
-      for (int n = 0; n < S; ++n) {
-        Real* q = e[a][n];
-        Real monomial = 0;
-        for (int k = 0; k < S; ++k) {
-          q[k] = power[k];
-          monomial += st.w[a][k] * q[k] * q[k];
-          power[k] *= u[k];
+    const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
+    Lanes u[S], w[S], power[S], q[S][S], norm_n[S], inv_norm[S];
+    for (int k = 0; k < S; ++k) {
+      u[k] = w[k] = Lanes{};
+      for (int a = 0; a < Dim; ++a) u[k][a] = st.d[a][k] * inv_dx, w[k][a] = st.w[a][k];
+      power[k] = 1 - Lanes{};
+    }
+    auto dropped = zero < zero;  // all lanes false
+    for (int n = 0; n < S; ++n) {
+      for (int k = 0; k < S; ++k) q[n][k] = power[k];
+      for (int pass = 0; pass < 2; ++pass) {
+        for (int m = 0; m < n; ++m) {
+          Lanes dot{};
+          for (int k = 0; k < S; ++k) dot += w[k] * q[n][k] * q[m][k];
+          const Lanes c = dot * inv_norm[m];
+          for (int k = 0; k < S; ++k) q[n][k] -= c * q[m][k];
         }
-        for (int pass = 0; pass < 2; ++pass) {
-          for (int m = 0; m < n; ++m) {
-            if (norm[a][m] == 0) continue;
-            Real dot = 0;
-            for (int k = 0; k < S; ++k) dot += st.w[a][k] * q[k] * e[a][m][k];
-            const Real c = dot / norm[a][m];
-            for (int k = 0; k < S; ++k) q[k] -= c * e[a][m][k];
-          }
-        }
-        Real nn = 0;
-        for (int k = 0; k < S; ++k) nn += st.w[a][k] * q[k] * q[k];
-        dropped = dropped || !(nn > tol * monomial);
-        norm[a][n] = dropped ? Real(0) : nn;
       }
+      Lanes nn{}, monomial{};
+      for (int k = 0; k < S; ++k) {
+        nn += w[k] * q[n][k] * q[n][k];
+        monomial += w[k] * power[k] * power[k];
+        power[k] *= u[k];
+      }
+      dropped = dropped | ~(nn > tol * monomial);  // lane masks: NaN is dropped too
+      norm_n[n] = dropped ? zero : nn;
+      inv_norm[n] = dropped ? zero : 1 / nn;
+    }
+    for (int a = 0; a < Dim; ++a) {
+      for (int n = 0; n < S; ++n) {
+        norm[a][n] = norm_n[n][a];
+        // The partition of unity makes e_0 = 1 a unit mode (sum_k w_a(k) = 1).
+        const Real inv_root = n == 0 ? Real(1) : std::sqrt(inv_norm[n][a]);
+        for (int k = 0; k < S; ++k) e[a][n][k] = q[n][k][a], unit[a][n][k] = q[n][k][a] * inv_root;
+        if (n == 1) root_norm[a] = norm_n[1][a] * inv_root;  // sqrt(norm), 0 if dropped
+      }
+      d0[a] = st.d[a][0];
     }
   }
 
@@ -96,36 +119,49 @@ struct PolyModes {
     return index;
   }
 
-  // sum_i w_ip s_r(i)^2, or 0 when the mode is dropped.
-  Real mode_norm(int r) const {
-    Real n = 1;
-    for (int a = Dim - 1; a >= 0; --a, r /= S) n *= norm[a][r % S];
-    return n;
-  }
-
-  // out[j] = sum_k T_a[j_a][k] in[j with j_a -> k] along one axis, with T_a = e[a]
-  // (nodal values -> mode sums) or its transpose (mode coefficients -> nodal values).
-  // The axis is a template parameter: its stride is then a constant, and the
-  // index arithmetic (a division and a remainder per entry) folds away.
+  // The transform in the orthonormal modes s_r / |s_r| (= prod_a unit[a][r_a]),
+  // on one SIMD row per node (Dim Reals, padded: core/pack.hpp), sum-factorised:
+  // Dim passes of S x S, each out[j] = sum_k U_a[j_a][k] in[j with j_a -> k]
+  // (nodal values -> mode sums) or with U_a^T (mode coefficients -> nodal
+  // values), U_a = unit[a]. The index arithmetic is constant once unrolled.
   template <bool Transpose, int A>
-  void apply_axis(const Vec<Dim>* in, Vec<Dim>* out) const {
-    constexpr int stride = ipow(S, Dim - 1 - A);
-    for (int j = 0; j < count; ++j) {
-      const int ja = (j / stride) % S, base = j - ja * stride;
-      Vec<Dim> acc = Vec<Dim>::Zero();
-      for (int k = 0; k < S; ++k)
-        acc += (Transpose ? e[A][k][ja] : e[A][ja][k]) * in[base + k * stride];
-      out[j] = acc;
+  MPMTB_INLINE void apply_axis(const Node* __restrict in, Node* __restrict out) const {
+    constexpr int stride = ipow(S, Dim - 1 - A), outer = ipow(S, A);
+    for (int o = 0; o < outer; ++o) {
+      const Node* x = in + o * S * stride;
+      Node* y = out + o * S * stride;
+      for (int n = 0; n < S; ++n) {
+        for (int i = 0; i < stride; ++i) {
+          Node acc = coefficient<Transpose, A>(n, 0) * x[i];
+          for (int k = 1; k < S; ++k)
+            acc.add_scaled(coefficient<Transpose, A>(n, k), x[k * stride + i]);
+          y[n * stride + i] = acc;
+        }
+      }
     }
   }
-  // Sum factorization: the S^Dim x S^Dim transform as Dim passes of S x S.
+  template <bool Transpose, int A>
+  MPMTB_INLINE Real coefficient(int n, int k) const {
+    return Transpose ? unit[A][k][n] : unit[A][n][k];
+  }
+  // From in to out (count values each).
   template <bool Transpose>
-  void transform(Vec<Dim>* values) const {
-    Vec<Dim> tmp[count];
+  void transform(const Vec<Dim>* in, Vec<Dim>* out) const {
+    Node buffer[2][count];
+    for (int j = 0; j < count; ++j) {
+      Real padded[kPad] = {};
+      for (int a = 0; a < Dim; ++a) padded[a] = in[j][a];
+      buffer[0][j] = Node::gather(padded);
+    }
     [&]<int... A>(std::integer_sequence<int, A...>) {
-      ((apply_axis<Transpose, A>(values, tmp), std::copy_n(tmp, count, values)), ...);
+      (apply_axis<Transpose, A>(buffer[A % 2], buffer[(A + 1) % 2]), ...);
     }
     (std::make_integer_sequence<int, Dim>{});
+    for (int j = 0; j < count; ++j) {
+      Real padded[kPad];
+      buffer[Dim % 2][j].store(padded);
+      for (int a = 0; a < Dim; ++a) out[j][a] = padded[a];
+    }
   }
 
   // Mode r = (r_0, ..., r_{Dim-1}) as a flat index: 0 is the constant, linear(a)
@@ -167,7 +203,7 @@ class PolypicPolicy {
     s.m = P.m[p];
     s.tauV = tauV;
     s.modes.build(st, dx_);
-    V* c = s.mv;
+    V c[kModes];  // the unit modes' coefficients
     const Real* stored = P.transfer_state_of(p);
     for (int r = 0; r < kModes; ++r) {
       if (Modes::higher(r)) {
@@ -176,18 +212,12 @@ class PolypicPolicy {
       }
     }
     c[0] = P.v[p];
-    // Linear modes in cell units: e_1 = (x_i - x_p)_a / dx, so c = C_p e_a dx.
-    for (int a = 0; a < Dim; ++a) c[Modes::linear(a)] = P.C[p].col(a) * dx_;
-    for (int r = 1; r < kModes; ++r) {
-      const Real n = s.modes.mode_norm(r);
-      if (n == 0) {
-        c[r].setZero();
-      } else if (Modes::higher(r)) {
-        c[r] /= std::sqrt(n);  // stored for the orthonormal mode (see finish)
-      }
-    }
-    s.modes.template transform<true>(c);  // coefficients -> nodal velocities
-    for (int j = 0; j < kModes; ++j) c[j] *= s.m;
+    // Linear modes in cell units: e_1 = (x_i - x_p)_a / dx, so c = C_p e_a dx,
+    // times |e_1| for the unit mode. The higher modes are stored for theirs.
+    for (int a = 0; a < Dim; ++a)
+      c[Modes::linear(a)] = P.C[p].col(a) * (dx_ * s.modes.root_norm[a]);
+    s.modes.template transform<true>(c, s.mv);  // coefficients -> nodal velocities
+    for (int j = 0; j < kModes; ++j) s.mv[j] *= s.m;
     return s;
   }
   void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
@@ -232,27 +262,29 @@ class PolypicPolicy {
     g.grad_v += v_i * grad.transpose();
   }
   void finish(Gather& g, Particles<Dim>& P, int p, Real dt) const {
-    V* c = g.wv;
-    g.modes.template transform<false>(c);  // sum_i w_ip s_r(i) v_i per mode
-    for (int r = 1; r < kModes; ++r) {
-      const Real n = g.modes.mode_norm(r);
-      c[r] = n > 0 ? V(c[r] / n) : V::Zero();
-    }
+    V c[kModes];
+    // sum_i w_ip s_r(i) v_i / |s_r| per mode: the coefficient of the unit mode
+    // s_r / |s_r| (the projection, as the unit modes are orthonormal), 0 for a
+    // dropped one.
+    g.modes.template transform<false>(g.wv, c);
     Real* stored = P.transfer_state_of(p);
     for (int r = 0; r < kModes; ++r) {
       if (Modes::higher(r)) {
-        // Stored as the coefficient of the orthonormal mode s_r / |s_r|: a particle's
-        // stencil energy sum_r |c_r|^2 |s_r|^2 then survives the rebuild of its modes
-        // at the moved position in P2G. Storing c_r itself let a nearly degenerate
-        // mode (tiny |s_r|, large c_r) gain norm one step later and inject energy
-        // (the disks gained 2.1x).
-        Eigen::Map<V>{stored} = c[r] * std::sqrt(g.modes.mode_norm(r));
+        // Stored as the coefficient of the unit mode: a particle's stencil energy
+        // sum_r |c_r|^2 then survives the rebuild of its modes at the moved
+        // position in P2G. Storing the coefficient of s_r itself let a nearly
+        // degenerate mode (tiny |s_r|, large coefficient) gain norm one step
+        // later and inject energy (the disks gained 2.1x).
+        Eigen::Map<V>{stored} = c[r];
         stored += Dim;
       }
     }
     // The constant mode is sum_i w_ip v_i (sum_i w_ip = 1): PIC's velocity.
     P.v[p] = g.v;
-    for (int a = 0; a < Dim; ++a) P.C[p].col(a) = c[Modes::linear(a)] / dx_;
+    for (int a = 0; a < Dim; ++a) {
+      const Real root = g.modes.root_norm[a];
+      P.C[p].col(a) = root > 0 ? V(c[Modes::linear(a)] / (root * dx_)) : V::Zero();
+    }
     P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
     P.x[p] += dt * g.v;
   }
