@@ -21,20 +21,27 @@ void write_atomically(const std::filesystem::path& path, const std::string& cont
 }
 
 std::string CsvTable::render() const {
+  std::string s = render_header(header);
+  for (const auto& row : rows) s += render_row(row);
+  return s;
+}
+
+std::string CsvTable::render_header(const std::vector<std::string>& header) {
   std::string s;
   for (std::size_t i = 0; i < header.size(); ++i) {
     if (i) s += ',';
     s += header[i];
   }
-  s += '\n';
-  for (const auto& row : rows) {
-    for (std::size_t i = 0; i < row.size(); ++i) {
-      if (i) s += ',';
-      s += fmt::format("{:.17g}", row[i]);
-    }
-    s += '\n';
+  return s + '\n';
+}
+
+std::string CsvTable::render_row(const std::vector<double>& row) {
+  std::string s;
+  for (std::size_t i = 0; i < row.size(); ++i) {
+    if (i) s += ',';
+    s += fmt::format("{:.17g}", row[i]);
   }
-  return s;
+  return s + '\n';
 }
 
 std::string csv_field(const std::string& s) {

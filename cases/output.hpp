@@ -15,6 +15,11 @@ struct CsvTable {
   std::vector<std::string> header;
   std::vector<std::vector<double>> rows;
   std::string render() const;
+  // The header line and one row line, each ending in a newline: render() is
+  // the header followed by every row, so a table streamed line by line
+  // (SeriesStream) has the same bytes as one rendered at the end.
+  static std::string render_header(const std::vector<std::string>& header);
+  static std::string render_row(const std::vector<double>& row);
 };
 
 // A text cell for a CSV table: quoted (with doubled quotes) when it holds a

@@ -7,14 +7,20 @@
 #include <cmath>
 #include <limits>
 
+#include "archive.hpp"
+#include "checkpoint.hpp"
 #include "core/diagnostics.hpp"
 #include "core/errors.hpp"
 #include "core/registry.hpp"
 #include "extra_columns.hpp"
+#include "memory.hpp"
 #include "output.hpp"
 #include "progress.hpp"
 #include "references/reference.hpp"
+#include "run_monitors.hpp"
+#include "series_stream.hpp"
 #include "setup.hpp"
+#include "stop.hpp"
 #include "version.hpp"
 #include "vtk/frames.hpp"
 
@@ -51,41 +57,6 @@ bool all_finite(const std::vector<double>& row) {
   return true;
 }
 
-// Tracks the run's conservation figures from the output samples.
-struct DriftMonitor {
-  Diagnostics first, last;
-  Real mechanical_max = 0;  // max of kinetic + strain
-  Real energy_dev_max = 0;  // max |E(t) - E(0)|
-  Real radius = 0;          // radius of gyration at t = 0
-
-  void start(const Diagnostics& d) { first = last = d; }
-  // work and impulse: what colliders, pinned nodes and gravity have done to the
-  // material so far; taken off so that the drifts are the scheme's own (wall
-  // reactions are not tracked and stay in the momentum drift).
-  void add(Diagnostics d, Real work, const Vec3& impulse) {
-    d.total -= work;
-    d.momentum -= impulse;
-    last = d;
-    mechanical_max = std::max(mechanical_max, d.kinetic + d.strain);
-    energy_dev_max = std::max(energy_dev_max, std::abs(d.total - first.total));
-  }
-  nlohmann::json json() const {
-    // Scales: momentum sqrt(2 M K_max), angular momentum that times the radius of
-    // gyration, energy the largest kinetic + strain energy seen.
-    const Real p_scale = std::sqrt(2 * first.mass * mechanical_max);
-    const Real L_scale = p_scale * radius;
-    auto ratio = [](Real num, Real den) { return den > 0 ? num / den : num; };
-    nlohmann::json j;
-    j["mass"] = ratio(std::abs(last.mass - first.mass), first.mass);
-    j["momentum"] = ratio((last.momentum - first.momentum).norm(), p_scale);
-    j["angular_momentum"] = ratio((last.angular_momentum - first.angular_momentum).norm(), L_scale);
-    j["energy"] = ratio(last.total - first.total, mechanical_max);
-    j["energy_max"] = ratio(energy_dev_max, mechanical_max);
-    j["volume"] = ratio(last.volume - first.volume, first.volume);
-    return j;
-  }
-};
-
 template <int Dim>
 Real gyration_radius(const State<Dim>& s, const Diagnostics& d) {
   Real sum = 0;
@@ -107,35 +78,6 @@ std::string failure_reason(const StepReport& r, Real J_floor) {
   if (r.outside >= 0) return fmt::format("particle {} left the domain", r.outside);
   return {};
 }
-
-// Compares each step with the CFL limit of the current state, dt_cfl = dx /
-// (c_p + max|v|) (CFL number 1; Courant, Friedrichs & Lewy 1928), and warns
-// once on stderr when the step exceeds it.
-struct CflCheck {
-  Real ratio_max = 0;  // max over the run of dt / dt_cfl
-  long first_step = -1;
-  Real first_t = 0;
-
-  void check(Real dt, Real dt_cfl, long step, Real t, const std::string& source) {
-    const Real ratio = dt / dt_cfl;
-    if (ratio > ratio_max) ratio_max = ratio;
-    if (ratio > 1 && first_step < 0) {
-      first_step = step;
-      first_t = t;
-      fmt::print(stderr,
-                 "mpmtb: warning: {}: dt = {:.4g} exceeds the CFL limit dx / (c_p + max|v|) = "
-                 "{:.4g} at step {} (t = {:.4g}); the explicit step may be unstable\n",
-                 source, dt, dt_cfl, step, t);
-    }
-  }
-  void add_to(nlohmann::json& j) const {
-    j["dt_cfl_ratio_max"] = ratio_max;
-    if (first_step >= 0) {
-      j["dt_cfl_exceeded"] = {
-          {"ratio_max", ratio_max}, {"first_step", first_step}, {"first_t", first_t}};
-    }
-  }
-};
 
 nlohmann::json base_summary(const Scene& scene) {
   nlohmann::json j;
@@ -160,6 +102,42 @@ nlohmann::json base_summary(const Scene& scene) {
   return j;
 }
 
+// What a checkpoint records besides the evolving state: the resolved scene
+// (base_summary's `config`) and the options that shape the output, so that
+// `--resume` rebuilds the same run.
+nlohmann::json checkpoint_meta(const Scene& scene, const RunOptions& options) {
+  nlohmann::json j = base_summary(scene);
+  j["threads"] = omp_get_max_threads();
+  j["frames"] = {{"every", options.frames.every},
+                 {"interval", options.frames.interval},
+                 {"grid", options.frames.grid}};
+  j["checkpoint_every"] = options.checkpoint_every;
+  return j;
+}
+
+// Writes DIR/checkpoint/state.bin atomically and keeps the figures the summary
+// reports (count, size, seconds).
+struct CheckpointLog {
+  long count = 0;
+  std::size_t bytes = 0;
+  double seconds = 0, seconds_max = 0;
+
+  void write(const std::filesystem::path& out_dir, const ArchiveWriter& a) {
+    const auto t0 = std::chrono::steady_clock::now();
+    write_atomically(checkpoint_file(out_dir), a.bytes());
+    const double dt = std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    ++count;
+    bytes = a.bytes().size();
+    seconds += dt;
+    seconds_max = std::max(seconds_max, dt);
+  }
+  void add_to(nlohmann::json& j) const {
+    if (count == 0) return;
+    j["checkpoints"] = {
+        {"count", count}, {"bytes", bytes}, {"seconds", seconds}, {"seconds_max", seconds_max}};
+  }
+};
+
 template <int Dim>
 RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
                    const RunOptions& options) {
@@ -169,14 +147,15 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   stepper->set_update_order(scene.update_order);
   stepper->prepare(s);  // one-time allocations, outside the timed steps
   auto reference = make_reference<Dim>(scene);
+  // Also on resume: a reference keeps what it needs of the initial state (the
+  // manufactured solution's X_p); the checkpoint then overwrites the particles.
   if (reference) reference->initialize(s);
 
-  CsvTable series;
-  series.header = kSeriesColumns;
+  std::vector<std::string> columns = kSeriesColumns;
   const ExtraColumns<Dim> extra(s);
-  for (const auto& c : extra.names()) series.header.push_back(c);
+  for (const auto& c : extra.names()) columns.push_back(c);
   if (reference) {
-    for (const auto& c : reference->columns()) series.header.push_back(c);
+    for (const auto& c : reference->columns()) columns.push_back(c);
   }
   auto sample = [&](const Diagnostics& d) {
     auto row = series_row(s.step, s.time, d);
@@ -187,60 +166,95 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
     return row;
   };
 
-  const Diagnostics d0 = measure(s, *stepper);
-  DriftMonitor drift;
-  drift.start(d0);
-  drift.radius = gyration_radius(s, d0);
-  drift.add(d0, 0, Vec3::Zero());
-  series.rows.push_back(sample(d0));
+  RunMonitors mon;
+  FrameSeries<Dim> frames(out_dir, options.frames);
+  SeriesStream series;
+  const std::string header = CsvTable::render_header(columns);
+  if (options.resume) {
+    ArchiveReader& a = *options.resume;
+    restore_state(a, s);
+    a.get("monitors", mon);
+    std::vector<Real> accumulated;
+    a.get_vector("reference", accumulated);
+    if (reference) reference->restore(accumulated);
+    frames.restore(a);
+    series.resume(out_dir / "series.csv", header, mon.series_bytes);
+    ++mon.sessions;
+  } else {
+    // A checkpoint left by an earlier run in DIR must not be resumed into this one.
+    std::filesystem::remove_all(out_dir / "checkpoint");
+    mon.d0 = measure(s, *stepper);
+    mon.drift.start(mon.d0);
+    mon.drift.radius = gyration_radius(s, mon.d0);
+    mon.drift.add(mon.d0, 0, Vec3::Zero());
+    for (const auto& v : s.particles.v) mon.v_max = std::max(mon.v_max, v.norm());
+    mon.J_min = mon.J_elastic_min = mon.d0.J_min;
+    mon.J_max = mon.J_elastic_max = mon.d0.J_max;
+    mon.next_output = scene.output_interval;
+    mon.next_checkpoint = options.checkpoint_every;
+    series.start(out_dir / "series.csv", header);
+    series.append(CsvTable::render_row(sample(mon.d0)));
+    frames.write(s);
+  }
+  const Diagnostics& d0 = mon.d0;
+
+  const nlohmann::json meta = checkpoint_meta(scene, options);
+  CheckpointLog checkpoints;
+  const auto wall_start = std::chrono::steady_clock::now();
+  auto wall_so_far = [&] {
+    return mon.wall_seconds +
+           std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  };
+  auto write_checkpoint = [&] {
+    RunMonitors saved = mon;
+    saved.series_bytes = series.bytes();
+    saved.wall_seconds = wall_so_far();
+    ArchiveWriter a;
+    a.put_string("meta", dump_json(meta));
+    save_state(a, s);
+    a.put("monitors", saved);
+    a.put_vector("reference", reference ? reference->saved() : std::vector<Real>{});
+    frames.save(a);
+    checkpoints.write(out_dir, a);
+  };
 
   const Real dx = s.grid.geo.dx;
-  Real c_max = 0;  // largest wave speed the CFL step used (hardening raises it)
-  Real v_max = 0;
-  for (const auto& v : s.particles.v) v_max = std::max(v_max, v.norm());
-  // J range: of the total deformation at output times, and of det F_p (the
-  // elastic part for plasticity) at every step, which is what inverts.
-  Real J_min = d0.J_min, J_max = d0.J_max, J_elastic_min = d0.J_min, J_elastic_max = d0.J_max;
-  Real dt_min = std::numeric_limits<Real>::infinity(), dt_max = 0;
-  CflCheck cfl_check;
-  Real next_output = scene.output_interval;
   std::string status = "ok", reason;
-  double step_seconds = 0;
-  const auto wall_start = std::chrono::steady_clock::now();
-  FrameSeries<Dim> frames(out_dir, options.frames);
-  frames.write(s);
+  int stop_exit = -1;
+  const StopWatch stops(options.wall_limit);
   Progress progress(options.label.empty() ? scene.name : options.label, options.progress);
 
   while (s.time < scene.t_end * (1 - 1e-12)) {
     const Real c = s.max_wave_speed();  // follows the current state (snow hardening)
     Real dt = scene.dt.value_or(0);
     if (!scene.dt) {
-      c_max = std::max(c_max, c);
-      dt = *scene.cfl * dx / (c + v_max);
+      mon.c_max = std::max(mon.c_max, c);
+      dt = *scene.cfl * dx / (c + mon.v_max);
     }
-    dt_min = std::min(dt_min, dt);  // the scheme's steps, before the last one is cut
-    dt_max = std::max(dt_max, dt);
-    cfl_check.check(dt, dx / (c + v_max), s.step, s.time, scene.source);
+    mon.dt_min = std::min(mon.dt_min, dt);  // the scheme's steps, before the last one is cut
+    mon.dt_max = std::max(mon.dt_max, dt);
+    mon.cfl_check.check(dt, dx / (c + mon.v_max), s.step, s.time, scene.source);
     dt = std::min(dt, scene.t_end - s.time);
     const auto t0 = std::chrono::steady_clock::now();
     const StepReport report = stepper->step(s, dt);
-    step_seconds += std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
-    v_max = report.v_max;
+    mon.step_seconds +=
+        std::chrono::duration<double>(std::chrono::steady_clock::now() - t0).count();
+    mon.v_max = report.v_max;
     progress.update(s.time / scene.t_end, s.step);
     reason = failure_reason(report, scene.J_floor);
     if (!reason.empty()) {
       status = "unstable";
       break;
     }
-    J_elastic_min = std::min(J_elastic_min, report.J_min);
-    J_elastic_max = std::max(J_elastic_max, report.J_max);
+    mon.J_elastic_min = std::min(mon.J_elastic_min, report.J_min);
+    mon.J_elastic_max = std::max(mon.J_elastic_max, report.J_max);
     const bool last = s.time >= scene.t_end * (1 - 1e-12);
     frames.after_step(s, last, dt);
-    if (s.time >= next_output - 1e-9 * dt || last) {
-      while (next_output <= s.time + 1e-9 * dt) next_output += scene.output_interval;
+    if (s.time >= mon.next_output - 1e-9 * dt || last) {
+      while (mon.next_output <= s.time + 1e-9 * dt) mon.next_output += scene.output_interval;
       const Diagnostics d = measure(s, *stepper);
-      J_min = std::min(J_min, d.J_min);
-      J_max = std::max(J_max, d.J_max);
+      mon.J_min = std::min(mon.J_min, d.J_min);
+      mon.J_max = std::max(mon.J_max, d.J_max);
       auto row = sample(d);
       // Energy above the limit times what was put in (initial kinetic + strain
       // energy plus the work of gravity and colliders) means the scheme is amplifying.
@@ -257,19 +271,41 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
       }
       const Vec3 impulse =
           s.collider_impulse + s.pin_impulse + d0.mass * s.time * to3<Dim>(s.gravity);
-      drift.add(d, s.collider_work, impulse);
-      series.rows.push_back(std::move(row));
+      mon.drift.add(d, s.collider_work, impulse);
+      series.append(CsvTable::render_row(row));  // on disk now: a stopped run keeps it
       if (status != "ok") break;
+    }
+    if (last) break;
+    // At a step boundary, after this step's output: the state a checkpoint
+    // holds is complete, and resuming it repeats nothing.
+    if (options.checkpoint_every > 0 && s.time >= mon.next_checkpoint - 1e-9 * dt) {
+      while (mon.next_checkpoint <= s.time + 1e-9 * dt)
+        mon.next_checkpoint += options.checkpoint_every;
+      write_checkpoint();
+    }
+    if (const auto stop = stops.due()) {
+      status = "interrupted";
+      reason = stop->reason;
+      stop_exit = stop->exit_status;
+      write_checkpoint();  // before the last frame below, which a resumed run rewrites
+      break;
     }
   }
   progress.finish();
-  frames.write(s);  // the last state, also of an unstable run (no-op if written)
-  const double wall_seconds =
-      std::chrono::duration<double>(std::chrono::steady_clock::now() - wall_start).count();
+  frames.write(s);  // the last state, also of an unstable or stopped run (no-op if written)
+  const double wall_seconds = wall_so_far();
 
   nlohmann::json j = base_summary(scene);
   j["status"] = status;
-  if (status != "ok") {
+  if (status == "interrupted") {
+    j["reason"] = reason;
+    j["stop_step"] = s.step;
+    j["stop_t"] = s.time;
+    j["resume"] = {{"command", fmt::format("mpmtb run --resume {}", out_dir.string())},
+                   {"checkpoint", checkpoint_file(out_dir).string()},
+                   {"step", s.step},
+                   {"t", s.time}};
+  } else if (status != "ok") {
     j["reason"] = reason;
     j["fail_step"] = s.step;
     j["fail_t"] = s.time;
@@ -278,29 +314,32 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   j["particles"] = s.particles.size();
   j["steps"] = s.step;
   j["t"] = s.time;
-  j["dt_min"] = dt_min;
-  j["dt_max"] = dt_max;
-  if (!scene.dt) j["wave_speed_max"] = c_max;
-  cfl_check.add_to(j);
+  j["dt_min"] = mon.dt_min;
+  j["dt_max"] = mon.dt_max;
+  if (!scene.dt) j["wave_speed_max"] = mon.c_max;
+  mon.cfl_check.add_to(j);
   j["threads"] = omp_get_max_threads();
   j["wall_seconds"] = wall_seconds;
-  j["step_seconds"] = step_seconds;
-  j["particle_steps_per_second"] = step_seconds > 0 ? particle_steps / step_seconds : 0;
-  j["ns_per_particle_step"] = particle_steps > 0 ? 1e9 * step_seconds / particle_steps : 0;
-  j["drift"] = drift.json();
-  j["J_min"] = J_min;
-  j["J_max"] = J_max;
-  j["J_elastic_min"] = J_elastic_min;
-  j["J_elastic_max"] = J_elastic_max;
+  j["step_seconds"] = mon.step_seconds;
+  j["particle_steps_per_second"] = mon.step_seconds > 0 ? particle_steps / mon.step_seconds : 0;
+  j["ns_per_particle_step"] = particle_steps > 0 ? 1e9 * mon.step_seconds / particle_steps : 0;
+  if (mon.sessions > 1) j["sessions"] = mon.sessions;
+  checkpoints.add_to(j);
+  j["drift"] = mon.drift.json();
+  j["J_min"] = mon.J_min;
+  j["J_max"] = mon.J_max;
+  j["J_elastic_min"] = mon.J_elastic_min;
+  j["J_elastic_max"] = mon.J_elastic_max;
   if (frames.enabled()) j["frames"] = frames.summary();
   if (reference) {
     j["error"] = reference->errors();
     j["measured"] = reference->measured();
   }
 
-  write_atomically(out_dir / "series.csv", series.render());
   write_atomically(out_dir / "summary.json", dump_json(j));
-  return {status, reason, j};
+  // A finished run needs no restart point (an unstable one would only repeat its failure).
+  if (status != "interrupted") std::filesystem::remove_all(out_dir / "checkpoint");
+  return {status, reason, j, stop_exit};
 }
 
 }  // namespace
@@ -332,6 +371,8 @@ RunOutcome run_scene(const Scene& scene, const std::filesystem::path& out_dir,
                      const RunOptions& options) {
   if (options.threads > 0) omp_set_num_threads(options.threads);
   try {
+    // Before anything is allocated: a run too large for the machine is refused.
+    check_memory(scene, options.frames, options.max_memory);
     switch (scene.dim) {
       case 1:
         return run_dim<1>(scene, out_dir, options);

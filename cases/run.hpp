@@ -12,17 +12,27 @@
 
 namespace mpmtb {
 
+class ArchiveReader;
+
 struct RunOptions {
-  int threads = 0;           // 0: OpenMP's default
-  FrameOptions frames = {};  // ParaView frames (off by default)
-  bool progress = false;     // draw a progress line on stderr (see Progress::wanted)
-  std::string label = {};    // names the run on the progress line
+  int threads = 0;              // 0: OpenMP's default
+  FrameOptions frames = {};     // ParaView frames (off by default)
+  bool progress = false;        // draw a progress line on stderr (see Progress::wanted)
+  std::string label = {};       // names the run on the progress line
+  double wall_limit = 0;        // stop cleanly after this many wall seconds (0: none)
+  double checkpoint_every = 0;  // simulated time between checkpoints (0: none)
+  // Bytes the run may use instead of the machine's MemAvailable (0: MemAvailable).
+  double max_memory = 0;
+  // A checkpoint to continue (its meta record already read): the run goes on
+  // from its state into the same folder.
+  ArchiveReader* resume = nullptr;
 };
 
 struct RunOutcome {
-  std::string status;  // ok | unstable | invalid
+  std::string status;  // ok | unstable | invalid | interrupted
   std::string reason;
   nlohmann::json summary;
+  int stop_exit = -1;  // interrupted: the exit status its stop asks for (130, 143, 124)
 };
 
 // Runs `scene` and writes its files under `out_dir`. Throws InputError when

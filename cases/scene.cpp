@@ -332,6 +332,11 @@ void apply_set(toml::table& tree, const std::string& assignment) {
 }
 
 void apply_overrides(toml::table& tree, const Overrides& o) {
+  // A scene that lists no `dims` supports only its own `dim`: keep that
+  // dimension, so that --dim (or --set scene.dim) cannot move it unnoticed.
+  const auto* header = tree["scene"].as_table();
+  const auto file_dim = tree["scene"]["dim"].value<std::int64_t>();
+  const bool declares_dims = header && header->contains("dims");
   auto set = [&](const std::string& key, auto value) {
     apply_set(tree, key + "=" + fmt::format("{}", value));
   };
@@ -361,6 +366,11 @@ void apply_overrides(toml::table& tree, const Overrides& o) {
     }
   }
   for (const auto& a : o.set) apply_set(tree, a);
+  auto* scene = tree["scene"].as_table();  // again: a --set may have replaced the table
+  if (scene && file_dim && !declares_dims &&
+      tree["scene"]["dim"].value<std::int64_t>() != file_dim) {
+    scene->insert_or_assign("dims", toml::array{*file_dim});
+  }
 }
 
 Scene read_scene(const toml::table& tree, const std::string& source) {

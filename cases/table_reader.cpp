@@ -31,6 +31,10 @@ Real TableReader::number(const std::string& key, const Range& range) {
     throw InputError(fmt::format("{}: expected a number ({})", field(key), range.text));
   }
   const Real v = n.value<double>().value();
+  if (!std::isfinite(v)) {
+    throw InputError(fmt::format("{} = {} is not allowed: the value must be finite ({})",
+                                 field(key), v, range.text));
+  }
   if (!range.ok(v)) {
     throw InputError(fmt::format("{} = {} is out of range: must be {}", field(key), v, range.text));
   }

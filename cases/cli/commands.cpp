@@ -7,13 +7,17 @@
 #include <iostream>
 #include <set>
 
+#include "archive.hpp"
+#include "checkpoint.hpp"
 #include "citations.hpp"
 #include "core/errors.hpp"
 #include "core/registry.hpp"
+#include "memory.hpp"
 #include "models/registry.hpp"
 #include "output.hpp"
 #include "progress.hpp"
 #include "reproduce.hpp"
+#include "version.hpp"
 
 namespace mpmtb {
 namespace {
@@ -78,6 +82,93 @@ int exit_status(const std::string& status) {
   return kExitInvalid;
 }
 
+int exit_status(const RunOutcome& r) {
+  if (r.status == "interrupted") return r.stop_exit;
+  return exit_status(r.status);
+}
+
+// --out must be a folder, or a path where one can be made: an existing file
+// there (or in its place among its parents) is refused before anything runs or
+// is written, instead of a filesystem error part way.
+void check_out_dir(const std::filesystem::path& out) {
+  std::error_code ec;
+  for (auto p = out; !p.empty(); p = p.parent_path()) {
+    if (!std::filesystem::exists(p, ec)) {
+      if (p == p.parent_path()) break;
+      continue;
+    }
+    if (!std::filesystem::is_directory(p, ec)) {
+      throw InputError(fmt::format(
+          "--out '{}': '{}' is an existing file, not a folder; give a new or an existing folder",
+          out.string(), p.string()));
+    }
+    break;
+  }
+}
+
+bool any_override(const Overrides& o) {
+  return o.dim || o.cells || o.ppc || o.transfer || o.kernel || o.update_order || o.model ||
+         o.cfl || o.dt || o.t_end || !o.set.empty();
+}
+
+// `mpmtb run --resume DIR`: the checkpoint's scene and options, continued in DIR.
+int resume_run(const RunRequest& request, RunOptions options) {
+  const std::filesystem::path dir = request.resume;
+  if (!request.scene.empty() || !request.config.empty() || any_override(request.overrides)) {
+    throw InputError(
+        "--resume continues a run as it was configured: give no scene, --config or scene "
+        "override (--dim, --cells, --set, ...)");
+  }
+  std::error_code ec;
+  if (!request.out.empty() && std::filesystem::weakly_canonical(request.out, ec) !=
+                                  std::filesystem::weakly_canonical(dir, ec)) {
+    throw InputError(fmt::format(
+        "--resume continues the run in its own folder '{}': drop --out '{}' (or give the same "
+        "folder)",
+        dir.string(), request.out));
+  }
+  const auto file = checkpoint_file(dir);
+  if (!std::filesystem::is_regular_file(file, ec)) {
+    throw InputError(fmt::format(
+        "--resume '{}': no checkpoint ({} is missing). A run writes one when it is stopped "
+        "(SIGINT, SIGTERM, --wall-limit) and every --checkpoint-every T, and removes it when "
+        "it finishes",
+        dir.string(), file.string()));
+  }
+  ArchiveReader archive = ArchiveReader::from_file(file);
+  const nlohmann::json meta = read_checkpoint_meta(archive);
+  const Scene scene = load_recorded_scene(meta, meta.value("source", file.string()));
+  const std::optional<int> threads = recorded_threads(meta);
+  if (options.threads == 0) {
+    options.threads = threads.value_or(0);
+  } else if (threads && *threads != options.threads) {
+    fmt::print(stderr,
+               "mpmtb: warning: resuming with {} threads, the run used {}: the output agrees to "
+               "round-off, not bit for bit\n",
+               options.threads, *threads);
+  }
+  if (meta.value("git_revision", "") != build_info().git_revision) {
+    fmt::print(stderr,
+               "mpmtb: warning: the checkpoint was written by revision {}, this is {}: the "
+               "output may differ from an uninterrupted run\n",
+               meta.value("git_revision", "?"), build_info().git_revision);
+  }
+  if (const auto& f = meta["frames"]; f.is_object()) {
+    options.frames.every = f.value("every", 0L);
+    options.frames.interval = f.value("interval", 0.0);
+    options.frames.grid = f.value("grid", false);
+  }
+  if (options.checkpoint_every == 0) options.checkpoint_every = meta.value("checkpoint_every", 0.0);
+  options.resume = &archive;
+  options.label = dir.string();
+  const RunOutcome r = run_scene(scene, dir, options);
+  if (!request.quiet) {
+    fmt::print(stderr, "{:<24} {}{}{}\n", dir.string(), r.status, r.reason.empty() ? "" : ": ",
+               r.reason);
+  }
+  return exit_status(r);
+}
+
 }  // namespace
 
 int command_list(const std::string& only, bool bibtex) {
@@ -125,6 +216,13 @@ int command_list(const std::string& only, bool bibtex) {
 }
 
 int command_run(const RunRequest& request) {
+  RunOptions options = request.options;
+  options.progress = Progress::wanted(request.quiet);
+  if (!request.max_memory.empty())
+    options.max_memory = parse_bytes(request.max_memory, "--max-memory");
+  if (!request.resume.empty()) return resume_run(request, options);
+  if (request.out.empty()) throw InputError("run: --out DIR is required (the output folder)");
+  check_out_dir(request.out);
   const auto transfers = expand(request.overrides.transfer, transfer_list());
   const auto kernels = expand(request.overrides.kernel, kernel_list());
   const bool sweep = transfers.size() > 1 || kernels.size() > 1;
@@ -132,7 +230,6 @@ int command_run(const RunRequest& request) {
   int worst = kExitOk;
   // --config: the recorded scene (and thread count, for identical output).
   nlohmann::json recorded;
-  RunOptions options = request.options;
   if (!request.config.empty()) {
     recorded = read_summary(request.config);
     if (options.threads == 0) options.threads = recorded_threads(recorded).value_or(0);
@@ -141,7 +238,6 @@ int command_run(const RunRequest& request) {
     return request.config.empty() ? load_scene(request.scene, o)
                                   : load_recorded_scene(recorded, request.config, o);
   };
-  options.progress = Progress::wanted(request.quiet);
   const std::string label = request.config.empty() ? request.scene : request.config;
   for (const auto& t : transfers) {
     for (const auto& k : kernels) {
@@ -173,9 +269,12 @@ int command_run(const RunRequest& request) {
         fmt::print(stderr, "{:<24} {}{}{}\n", sweep ? name : label, r.status,
                    r.reason.empty() ? "" : ": ", r.reason);
       }
-      worst = std::max(worst, exit_status(r.status));
+      const bool stopped = r.status == "interrupted";
+      worst = stopped ? exit_status(r) : std::max(worst, exit_status(r));
       runs.emplace_back(name, std::move(r));
+      if (stopped) break;  // a stop ends the sweep too
     }
+    if (!runs.empty() && runs.back().second.status == "interrupted") break;
   }
   if (sweep) write_runs_table(request.out, runs);
   return worst;

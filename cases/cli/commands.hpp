@@ -14,10 +14,12 @@ enum ExitStatus { kExitOk = 0, kExitError = 1, kExitInvalid = 2, kExitUnstable =
 struct RunRequest {
   std::string scene;
   std::string config;  // a summary.json to re-run instead of `scene`
+  std::string resume;  // a run folder whose checkpoint to continue, instead of `scene`
   Overrides overrides;
   std::string out;
   RunOptions options;
-  bool quiet = false;  // no progress line and no per-run status lines
+  std::string max_memory;  // --max-memory SIZE as given (parse_bytes)
+  bool quiet = false;      // no progress line and no per-run status lines
 };
 
 // `only`: the names of one group; `bibtex`: the papers behind the variants instead.

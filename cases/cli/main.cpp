@@ -5,6 +5,7 @@
 #include <CLI/CLI.hpp>
 
 #include <exception>
+#include <new>
 
 #include "boundary/walls.hpp"
 #include "commands.hpp"
@@ -183,8 +184,24 @@ int main(int argc, char** argv) {
                 "no progress line and no status line (a progress line is drawn only when "
                 "stderr is a terminal)")
       ->capture_default_str();
-  run->add_option("--out", run_request.out, "output folder (created; files in it are replaced)")
-      ->required();
+  run->add_option("--out", run_request.out,
+                  "output folder (created; files in it are replaced); required unless --resume");
+  run->add_option("--wall-limit", run_request.options.wall_limit,
+                  "stop cleanly after SECONDS of wall time, as on SIGINT/SIGTERM: series and "
+                  "summary (status interrupted) written, a checkpoint to --resume, exit 124")
+      ->check(CLI::PositiveNumber);
+  run->add_option("--checkpoint-every", run_request.options.checkpoint_every,
+                  "write the complete state to DIR/checkpoint/state.bin every T of simulated "
+                  "time (atomically; removed when the run finishes)")
+      ->check(CLI::PositiveNumber);
+  auto* resume_opt = run->add_option(
+      "--resume", run_request.resume,
+      "continue the stopped run in DIR from DIR/checkpoint/ with its own scene, options and "
+      "thread count; the result equals an uninterrupted run byte for byte");
+  resume_opt->excludes(scene_opt)->excludes(config_opt);
+  run->add_option("--max-memory", run_request.max_memory,
+                  "memory the run may use, e.g. 64G or 512M (default: the machine's "
+                  "MemAvailable); larger estimates are refused before anything is allocated");
 
   std::string describe_scene;
   mpmtb::Overrides describe_overrides;
@@ -220,12 +237,20 @@ int main(int argc, char** argv) {
     if (*suite) return mpmtb::command_suite(suite_request);
     if (*compare) return mpmtb::compare::command_compare(compare_request);
     if (*render) return forward_to_render(render->remaining());
-    if (run_request.scene.empty() && run_request.config.empty()) {
-      throw mpmtb::InputError("run: give a scene (name or file) or --config DIR/summary.json");
+    if (run_request.scene.empty() && run_request.config.empty() && run_request.resume.empty()) {
+      throw mpmtb::InputError(
+          "run: give a scene (name or file), --config DIR/summary.json or --resume DIR");
     }
     return mpmtb::command_run(run_request);
   } catch (const mpmtb::InputError& e) {
     fmt::print(stderr, "mpmtb: invalid input: {}\n", one_line(e.what()));
+    return mpmtb::kExitInvalid;
+  } catch (const std::bad_alloc&) {
+    // The estimate (cases/memory.hpp) refuses what clearly does not fit; this is
+    // what slips past it (other processes took the memory meanwhile).
+    fmt::print(stderr,
+               "mpmtb: invalid input: the run needs more memory than the machine could give (an "
+               "allocation failed); reduce grid.cells, grid.ppc or the domain\n");
     return mpmtb::kExitInvalid;
   } catch (const std::exception& e) {
     fmt::print(stderr, "mpmtb: error: {}\n", one_line(e.what()));

@@ -1,5 +1,7 @@
 #include "references/column.hpp"
 
+#include <fmt/format.h>
+
 #include <algorithm>
 #include <limits>
 
@@ -48,6 +50,15 @@ template <int Dim>
 nlohmann::json ColumnCollapse<Dim>::measured() const {
   return {{"aspect_ratio", h0_ / w0_}, {"w0", w0_},         {"h0", h0_},
           {"front_x", front_},         {"runout", runout_}, {"height", height_}};
+}
+
+template <int Dim>
+void ColumnCollapse<Dim>::restore(const std::vector<Real>& v) {
+  if (v.size() != 4) {
+    throw InputError(
+        fmt::format("checkpoint: the column reference keeps {} values, found {}", 4, v.size()));
+  }
+  front0_ = v[0], front_ = v[1], runout_ = v[2], height_ = v[3];
 }
 
 template class ColumnCollapse<1>;

@@ -29,6 +29,8 @@ class ColumnCollapse final : public Reference<Dim> {
   std::vector<Real> sample(const State<Dim>& s, const Diagnostics& d) override;
   nlohmann::json errors() const override { return nlohmann::json::object(); }
   nlohmann::json measured() const override;
+  std::vector<Real> saved() const override { return {front0_, front_, runout_, height_}; }
+  void restore(const std::vector<Real>& v) override;
 
  private:
   Real w0_ = 0, h0_ = 0, floor_y_ = 0;

@@ -186,6 +186,15 @@ nlohmann::json ManufacturedReference<Dim>::measured() const {
 template struct AxisAlignedSolution<1>;
 template struct AxisAlignedSolution<2>;
 template struct AxisAlignedSolution<3>;
+template <int Dim>
+void ManufacturedReference<Dim>::restore(const std::vector<Real>& v) {
+  if (v.size() != 2) {
+    throw InputError(fmt::format(
+        "checkpoint: the manufactured-solution reference keeps {} values, found {}", 2, v.size()));
+  }
+  max_l2_ = v[0], max_linf_ = v[1];
+}
+
 template class ManufacturedReference<1>;
 template class ManufacturedReference<2>;
 template class ManufacturedReference<3>;

@@ -52,6 +52,8 @@ class ManufacturedReference final : public Reference<Dim> {
   std::vector<Real> sample(const State<Dim>& s, const Diagnostics& d) override;
   nlohmann::json errors() const override;
   nlohmann::json measured() const override;
+  std::vector<Real> saved() const override { return {max_l2_, max_linf_}; }
+  void restore(const std::vector<Real>& v) override;
 
   const AxisAlignedSolution<Dim>& solution() const { return exact_; }
 

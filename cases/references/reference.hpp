@@ -29,6 +29,11 @@ class Reference {
   virtual nlohmann::json errors() const = 0;
   // Measured and exact characteristic values (the summary's "measured" object).
   virtual nlohmann::json measured() const { return nlohmann::json::object(); }
+  // What sample() has accumulated so far, for a checkpoint: restore(saved()) on
+  // a reference built and initialized from the same scene continues it as if
+  // the run had not stopped (a resumed run reports the same error norms).
+  virtual std::vector<Real> saved() const = 0;
+  virtual void restore(const std::vector<Real>& values) = 0;
 };
 
 std::vector<std::string> reference_kinds();

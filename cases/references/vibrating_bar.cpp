@@ -90,6 +90,26 @@ Real period_from_zero_crossings(const std::vector<Real>& t, const std::vector<Re
   return 2 * (crossings.back() - crossings.front()) / static_cast<Real>(crossings.size() - 1);
 }
 
+template <int Dim>
+std::vector<Real> VibratingBar<Dim>::saved() const {
+  std::vector<Real> v = {max_vcm_error_};
+  v.insert(v.end(), t_.begin(), t_.end());
+  v.insert(v.end(), vcm_.begin(), vcm_.end());
+  return v;
+}
+
+template <int Dim>
+void VibratingBar<Dim>::restore(const std::vector<Real>& v) {
+  if (v.empty() || v.size() % 2 != 1) {
+    throw InputError(fmt::format(
+        "checkpoint: the vibrating-bar reference keeps 1 + 2 n values, found {}", v.size()));
+  }
+  const auto n = static_cast<long>(v.size() / 2);
+  max_vcm_error_ = v[0];
+  t_.assign(v.begin() + 1, v.begin() + 1 + n);
+  vcm_.assign(v.begin() + 1 + n, v.end());
+}
+
 template class VibratingBar<1>;
 template class VibratingBar<2>;
 template class VibratingBar<3>;

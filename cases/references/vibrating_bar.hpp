@@ -27,6 +27,9 @@ class VibratingBar final : public Reference<Dim> {
   std::vector<Real> sample(const State<Dim>& s, const Diagnostics& d) override;
   nlohmann::json errors() const override;
   nlohmann::json measured() const override;
+  // The largest error, then the sample times, then v_cm at those times.
+  std::vector<Real> saved() const override;
+  void restore(const std::vector<Real>& v) override;
 
   Real beta() const { return beta_; }
   Real omega() const { return omega_; }

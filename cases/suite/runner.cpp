@@ -286,6 +286,9 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
     if (pid > 0 && running.count(pid)) {
       const Child c = running[pid];
       running.erase(pid);
+      // A child that the same Ctrl-C stopped (mpmtb run stops cleanly on
+      // SIGINT) is unfinished, not a result: the resumed suite runs it again.
+      if (g_stop) continue;
       const double seconds = std::chrono::duration<double>(Clock::now() - c.start).count();
       results[c.index] =
           settle(specs[c.index], root / specs[c.index].dir, status, c.timed_out, seconds);

@@ -20,6 +20,8 @@
 #include <utility>
 #include <vector>
 
+#include "archive.hpp"
+#include "core/errors.hpp"
 #include "core/state.hpp"
 #include "output.hpp"
 #include "vtk/frame_options.hpp"
@@ -178,11 +180,56 @@ class FrameSeries {
   }
   bool enabled() const { return options_.enabled(); }
 
+  // For a checkpoint: which frames exist and when the next is due, so that a
+  // resumed run writes the frames (and .pvd lists) an uninterrupted one would.
+  void save(ArchiveWriter& a) const {
+    a.put("frames.next_time", next_time_);
+    a.put("frames.last_step", last_step_);
+    a.put("frames.bytes", bytes_);
+    a.put("frames.seconds", seconds_);
+    save_list(a, "frames.particles", particles_);
+    save_list(a, "frames.grids", grids_);
+  }
+  void restore(ArchiveReader& a) {
+    a.get("frames.next_time", next_time_);
+    a.get("frames.last_step", last_step_);
+    a.get("frames.bytes", bytes_);
+    a.get("frames.seconds", seconds_);
+    particles_ = restore_list(a, "frames.particles");
+    grids_ = restore_list(a, "frames.grids");
+  }
+
  private:
+  using List = std::vector<std::pair<double, std::string>>;
+  // Times as raw doubles, names one per line (they are frames/NAME_NNNNN.ext).
+  static void save_list(ArchiveWriter& a, const std::string& key, const List& list) {
+    std::vector<double> times;
+    std::string names;
+    for (const auto& [t, name] : list) times.push_back(t), names += name + '\n';
+    a.put_vector(key + ".times", times);
+    a.put_string(key + ".names", names);
+  }
+  static List restore_list(ArchiveReader& a, const std::string& key) {
+    std::vector<double> times;
+    a.get_vector(key + ".times", times);
+    const std::string names = a.get_string(key + ".names");
+    List list;
+    std::size_t at = 0;
+    for (double t : times) {
+      const std::size_t end = names.find('\n', at);
+      if (end == std::string::npos) break;
+      list.emplace_back(t, names.substr(at, end - at));
+      at = end + 1;
+    }
+    if (list.size() != times.size())
+      throw InputError(a.source() + ": field `" + key + ".names`: fewer names than times");
+    return list;
+  }
+
   std::filesystem::path dir_;
   FrameOptions options_;
   Real next_time_;
-  std::vector<std::pair<double, std::string>> particles_, grids_;
+  List particles_, grids_;
   long last_step_ = -1;
   std::size_t bytes_ = 0;
   double seconds_ = 0;
