@@ -331,11 +331,21 @@ void apply_set(toml::table& tree, const std::string& assignment) {
   target->insert_or_assign(keys.back(), *parsed.get("v"));
 }
 
+// The integer at `view`, if it holds one. toml++'s value<int64_t>() would
+// also convert a float, and a float beyond int64's range is undefined
+// behaviour (UBSan caught dim = 1e308 in the scene fuzz test).
+namespace {
+std::optional<std::int64_t> integer_at(toml::node_view<toml::node> view) {
+  if (const auto* i = view.as_integer()) return i->get();
+  return std::nullopt;
+}
+}  // namespace
+
 void apply_overrides(toml::table& tree, const Overrides& o) {
   // A scene that lists no `dims` supports only its own `dim`: keep that
   // dimension, so that --dim (or --set scene.dim) cannot move it unnoticed.
   const auto* header = tree["scene"].as_table();
-  const auto file_dim = tree["scene"]["dim"].value<std::int64_t>();
+  const auto file_dim = integer_at(tree["scene"]["dim"]);
   const bool declares_dims = header && header->contains("dims");
   auto set = [&](const std::string& key, auto value) {
     apply_set(tree, key + "=" + fmt::format("{}", value));
@@ -368,7 +378,7 @@ void apply_overrides(toml::table& tree, const Overrides& o) {
   for (const auto& a : o.set) apply_set(tree, a);
   auto* scene = tree["scene"].as_table();  // again: a --set may have replaced the table
   if (scene && file_dim && !declares_dims &&
-      tree["scene"]["dim"].value<std::int64_t>() != file_dim) {
+      integer_at(tree["scene"]["dim"]) != file_dim) {
     scene->insert_or_assign("dims", toml::array{*file_dim});
   }
 }

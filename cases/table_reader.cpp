@@ -119,11 +119,11 @@ std::vector<int> TableReader::int_list(const std::string& key, int lo, int hi) {
   if (!a) throw InputError(fmt::format("{}: expected an array of integers", field(key)));
   std::vector<int> out;
   for (const auto& e : *a) {
-    const auto v = e.value<std::int64_t>();
-    if (!e.is_integer() || *v < lo || *v > hi) {
+    const auto* v = e.as_integer();  // never value<int64_t>(): it converts floats
+    if (!v || v->get() < lo || v->get() > hi) {
       throw InputError(fmt::format("{}: expected integers in [{}, {}]", field(key), lo, hi));
     }
-    out.push_back(static_cast<int>(*v));
+    out.push_back(static_cast<int>(v->get()));
   }
   return out;
 }
