@@ -377,8 +377,7 @@ void apply_overrides(toml::table& tree, const Overrides& o) {
   }
   for (const auto& a : o.set) apply_set(tree, a);
   auto* scene = tree["scene"].as_table();  // again: a --set may have replaced the table
-  if (scene && file_dim && !declares_dims &&
-      integer_at(tree["scene"]["dim"]) != file_dim) {
+  if (scene && file_dim && !declares_dims && integer_at(tree["scene"]["dim"]) != file_dim) {
     scene->insert_or_assign("dims", toml::array{*file_dim});
   }
 }

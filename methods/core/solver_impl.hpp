@@ -10,20 +10,34 @@
 #include <limits>
 #include <utility>
 
-#include "core/nonlocal.hpp"
-#include "core/particle_blocks.hpp"
 #include "core/policy_hooks.hpp"
 #include "core/solver.hpp"
+#include "core/solver_stages.hpp"
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
 #include "kernels/all.hpp"
 
 namespace mpmtb {
 
+// A transfer that never reads v_old scatters (m_i, p_i + dt f_i): the force
+// folded into the momentum, half the row per node (NodeSums, kFolded).
 template <int Dim, class Kernel, class Transfer>
-class Solver final : public Stepper<Dim> {
+constexpr bool folds_force() {
+  using Policy = typename Transfer::template Policy<Dim, Kernel>;
+  constexpr bool filters_old_velocity = requires(const Policy& q) {
+    q.old_velocity_series();
+  };
+  return has_tensor_path<Policy>() && !Transfer::needs_old_velocity && !filters_old_velocity;
+}
+
+// The transfer-independent stages come from the base (core/solver_stages.hpp),
+// compiled once per dimension and kernel.
+template <int Dim, class Kernel, class Transfer>
+class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, Transfer>()> {
   using Policy = typename Transfer::template Policy<Dim, Kernel>;
   using StencilT = Stencil<Dim, Kernel>;
+  static constexpr bool kFoldForce = folds_force<Dim, Kernel, Transfer>();
+  using Base = SolverStages<Dim, Kernel, kFoldForce>;
   // The policy's transfers as sums over the stencil (core/tensor_transfer.hpp),
   // or, for a policy that does not declare them, its per-node math.
   static constexpr bool kTensorPath = has_tensor_path<Policy>();
@@ -40,13 +54,22 @@ class Solver final : public Stepper<Dim> {
   static constexpr bool kFiltersOldVelocity = requires(const Policy& q) {
     q.old_velocity_series();
   };
-  // A transfer that never reads v_old scatters (m_i, p_i + dt f_i): the force
-  // folded into the momentum, half the row per node (NodeSums, kFolded).
-  static constexpr bool kFoldForce =
-      kTensorPath && !Transfer::needs_old_velocity && !kFiltersOldVelocity;
+  using Base::bin;
+  using Base::blocks_;
+  using Base::clear_active_box;
+  using Base::compute_stresses;
+  using Base::for_each_active_node;
+  using Base::for_each_active_row;
+  using Base::pack_velocities;
+  using Base::sums_;
+  using Base::sums_kept_;
+  using Base::tauV_;
+  using Base::unpack_and_drain;
+  using Base::unpack_and_keep;
+  using Base::v_rows_;
 
  public:
-  Solver(Parameters& transfer_params) : transfer_params_(transfer_params) {}
+  Solver(Parameters& transfer_params) : Base(kTensorPath), transfer_params_(transfer_params) {}
 
   std::string_view transfer_name() const override { return Transfer::name; }
   std::string_view kernel_name() const override { return Kernel::name; }
@@ -62,10 +85,10 @@ class Solver final : public Stepper<Dim> {
     compute_stresses(s);
     s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
-    blocks_.bin(s);
+    bin(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
     blocks_.for_each_coloured(s, [&](int p) { scatter_particle<true>(s, policy, p, dt); });
-    if constexpr (kTensorPath) unpack_sums<true, true>(s.grid);
+    if constexpr (kTensorPath) unpack_and_drain(s.grid);
   }
 
   void update_grid(State<Dim>& s, Real dt) override {
@@ -161,10 +184,6 @@ class Solver final : public Stepper<Dim> {
     return {J_min, J_max, v_max, non_finite == n ? -1 : non_finite, outside == n ? -1 : outside};
   }
 
-  void nonlocal_update(State<Dim>& s) override {
-    nonlocal_.apply(s);
-  }
-
   Vec3 affine_angular_momentum(const State<Dim>& s) const override {
     Vec3 L = Vec3::Zero();
     if constexpr (Transfer::affine_momentum && Dim >= 2) {
@@ -191,126 +210,16 @@ class Solver final : public Stepper<Dim> {
     tauV_.assign(s.particles.size(), Mat<Dim>::Zero());
     s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
-    blocks_.bin(s);
+    bin(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
     blocks_.for_each_coloured(s, [&](int p) { scatter_particle<false>(s, policy, p, 0); });
     if constexpr (kTensorPath) {
-      unpack_sums<true, false>(s.grid);  // kept for scatter_forces (usf); musl has none
+      unpack_and_keep(s.grid);  // kept for scatter_forces (usf); musl has none
       sums_kept_ = true;
     }
   }
-  // Force, on the blocks scatter_momentum binned (the particles have not moved),
-  // added to the momentum sums that scatter_momentum left.
-  void scatter_forces(State<Dim>& s, Real dt) override {
-    compute_stresses(s);
-    blocks_.for_each_coloured(s, [&](int p) { scatter_force(s, p, dt); });
-    unpack_sums<kTensorPath, true>(s.grid);
-    sums_kept_ = false;
-  }
-
-  // v_i = p_i / m_i with walls, pinned nodes and colliders, for the F update.
-  // Folding the walls' ghosts changes m and p, which the grid update that may
-  // follow (usf) folds again, so they are kept and restored; no impulse is
-  // exchanged with the boundaries here, so none is recorded.
-  void grid_velocities(State<Dim>& s, Real t) override {
-    Grid<Dim>& g = s.grid;
-    m_kept_.resize(g.m.size());
-    p_kept_.resize(g.p.size());
-    for_each_active_row(g, [&](long first, long count) {
-      std::copy_n(g.m.begin() + first, count, m_kept_.begin() + first);
-      std::copy_n(g.p.begin() + first, count, p_kept_.begin() + first);
-    });
-    s.walls.fold(g);
-    for_each_active_node(g, [&](long i) {
-      if (g.m[i] > 0 && !g.pinned[i]) {
-        g.v[i] = g.p[i] / g.m[i];
-      } else {
-        g.v[i].setZero();
-      }
-    });
-    s.walls.apply(g);
-    if (!s.colliders.empty()) {
-      Vec3 impulse = Vec3::Zero();
-      Real work = 0;
-      s.colliders.apply(g, t, impulse, work);
-    }
-    for_each_active_row(g, [&](long first, long count) {
-      std::copy_n(m_kept_.begin() + first, count, g.m.begin() + first);
-      std::copy_n(p_kept_.begin() + first, count, g.p.begin() + first);
-    });
-  }
-
-  // F_p <- (I + dt sum_i v_i grad w_ip^T) F_p, the F update of every
-  // gradient-based transfer (Sulsky et al. 1994), from the grid's v.
-  StepReport update_deformation(State<Dim>& s, Real dt) override {
-    Particles<Dim>& P = s.particles;
-    const Grid<Dim>& g = s.grid;
-    pack_velocities(v_rows_, g, g.v.data(), nullptr);
-    const long n = static_cast<long>(P.size());
-    Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min;
-    long non_finite = n;
-#pragma omp parallel for schedule(static) reduction(min                  \
-                                                    : J_min, non_finite) \
-    reduction(max                                                        \
-              : J_max) if (n >= kParallelMinimum)
-    for (long p = 0; p < n; ++p) {
-      const StencilT st(P.x[p], g.geo);
-      const Mat<Dim> G =
-          TensorTransfer<Dim, Kernel>::template gather<TensorTerms{.gradient = true}>(
-              st, g.geo, v_rows_.data())
-              .G;
-      P.F[p] = (Mat<Dim>::Identity() + dt * G) * P.F[p];
-      const Real J = P.F[p].determinant();
-      J_min = std::min(J_min, J);
-      J_max = std::max(J_max, J);
-      if (!std::isfinite(J)) non_finite = std::min(non_finite, p);
-    }
-    return {J_min, J_max, 0, non_finite == n ? -1 : non_finite, -1};
-  }
 
  private:
-  void compute_stresses(const State<Dim>& s) {
-    tauV_.resize(s.particles.size());
-    for (std::size_t m = 0; m < s.materials.size(); ++m) {
-      s.materials[m]->kirchhoff_times_volume(s.particles, s.material_particles[m], tauV_);
-    }
-  }
-
-  // Zeroes every nodal field over the active box of the previous step: the grid
-  // is zero everywhere before the scatter, at a cost that follows the particles.
-  // The scatter's sums are zero outside the calls that fill and drain them, but
-  // for those that scatter_momentum kept and no scatter_forces drained (musl).
-  void clear_active_box(Grid<Dim>& g) {
-    sums_.resize(g.size());
-    const bool clear_sums = std::exchange(sums_kept_, false);
-    for_each_active_row(g, [&](long first, long count) {
-      std::fill_n(g.m.begin() + first, count, Real(0));
-      std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
-      std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
-      std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
-      std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
-      std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
-      if (clear_sums) sums_.clear(first, count);
-    });
-  }
-
-  // m_i, p_i, f_i <- the scatter's sums over the active box (NodeSums::unpack).
-  template <bool kMomentum, bool kDrain>
-  void unpack_sums(Grid<Dim>& g) {
-    for_each_active_row(g, [&](long first, long count) {
-      sums_.template unpack<kMomentum, kDrain>(first, count, g.m.data(), g.p.data(), g.f.data());
-    });
-  }
-
-  // The gathers' input: v and v_old (if the rows hold it) packed over the active
-  // box (VelocityRows), which holds every stencil of the particles that scattered.
-  template <class Rows>
-  void pack_velocities(Rows& rows_out, const Grid<Dim>& g, const Vec<Dim>* v,
-                       const Vec<Dim>* v_old) {
-    rows_out.resize(g.size());
-    for_each_active_row(g, [&](long first, long count) { rows_out.pack(first, count, v, v_old); });
-  }
-
   // kBodyForce = false: the momentum part only (tauV_ is zero then). dt: the
   // step that folded sums integrate the force over (kFoldForce).
   template <bool kBodyForce>
@@ -329,7 +238,7 @@ class Solver final : public Stepper<Dim> {
         form.alpha.template segment<Dim>(ScatterForm<Dim>::f) +=
             P.m[p] * s.body_force(P, p, s.time);
       }
-      add_form(st, g.geo, form, dt);
+      this->template add_form<Policy::scatter_terms>(st, g.geo, form, dt);
     } else if (!kBodyForce || !s.body_force) {
       st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
         policy.scatter(src, w, grad, d, m[node], mom[node], f[node]);
@@ -345,31 +254,6 @@ class Solver final : public Stepper<Dim> {
       st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
         if (w > 0) g.pinned[node] = 1;
       });
-    }
-  }
-
-  // f_i += -V0_p tau_p grad w_ip + w_ip m_p b_p: the force of a gradient-based
-  // transfer (Sulsky et al. 1994), the force part of the split P2G.
-  void scatter_force(State<Dim>& s, int p, Real dt) {
-    const Particles<Dim>& P = s.particles;
-    Grid<Dim>& g = s.grid;
-    using Form = ScatterForm<Dim>;
-    Form form;
-    for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(Form::f) = -tauV_[p].col(a);
-    if (s.body_force)
-      form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
-    add_form<TensorTerms{.gradient = true}>(StencilT(P.x[p], g.geo), g.geo, form, dt);
-  }
-
-  // The form into the P2G sums, folded with dt or not (kFoldForce).
-  template <TensorTerms T = Policy::scatter_terms>
-  void add_form(const StencilT& st, const GridGeometry<Dim>& geo, const ScatterForm<Dim>& form,
-                Real dt) {
-    using Sums = TensorTransfer<Dim, Kernel>;
-    if constexpr (kFoldForce) {
-      Sums::template scatter_folded<T>(st, geo, form, dt, sums_.data());
-    } else {
-      Sums::template scatter<T>(st, geo, form, sums_.data());
     }
   }
 
@@ -424,26 +308,9 @@ class Solver final : public Stepper<Dim> {
     }
   }
 
-  // f(first, count) for every row of the active box (runs of consecutive nodes
-  // along the last axis), in parallel.
-  template <class F>
-  static void for_each_active_row(const Grid<Dim>& g, F&& f) {
-    g.active.for_each_row(g.geo.strides(), f);
-  }
-  // f(node) for every node of the active box, in parallel over its rows.
-  template <class F>
-  static void for_each_active_node(const Grid<Dim>& g, F&& f) {
-    g.active.for_each_node(g.geo.strides(), f);
-  }
-
   Parameters transfer_params_;
-  std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
-  std::vector<Vec<Dim>> p_kept_;
-  std::vector<Mat<Dim>> tauV_;      // V0_p tau_p, from the materials
-  NodeSums<Dim, kFoldForce> sums_;  // the fast path's P2G accumulator
-  bool sums_kept_ = false;          // sums_ holds scatter_momentum's sums (see clear_active_box)
   // The fast path's G2P input: v (and v_old if the policy reads it) for the
-  // transfer's gather, v alone for the gradient-based F update and XPIC's filter.
+  // transfer's gather (v alone for the F update and XPIC's filter: v_rows_).
   static constexpr bool kGatherOld = [] {
     if constexpr (kTensorPath) {
       return Policy::gather_terms.old;
@@ -452,12 +319,9 @@ class Solver final : public Stepper<Dim> {
     }
   }();
   VelocityRows<Dim, kGatherOld> rows_;
-  VelocityRows<Dim, false> v_rows_;
-  ParticleBlocks<Dim, Kernel> blocks_;  // P2G's colouring (core/particle_blocks.hpp)
   // Scratch of filter_old_velocity: nodal field, sums and masses; particle values.
   std::vector<Vec<Dim>> q_field_, q_sum_, q_particle_;
   std::vector<Real> q_mass_;
-  NonlocalLaplacian<Dim, Kernel> nonlocal_;
 };
 
 template <int Dim, class Kernel, class Transfer>

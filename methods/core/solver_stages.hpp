@@ -1,0 +1,107 @@
+// The stages of a step that do not depend on the transfer scheme, compiled once
+// per dimension, kernel and layout of the P2G sums (core/solver_stages_*d.cpp)
+// instead of once per transfer: the gradient-based force scatter and F update
+// of the split orders (usf, musl), the grid velocities that update F, the
+// stresses, the scatter's bookkeeping (binning, clearing and unpacking the sums)
+// and the nonlocal Laplacian. Each transfer's Solver (core/solver_impl.hpp)
+// derives from this class and adds its own P2G, grid update and G2P. Only the
+// declarations are here, so that a transfer's file does not compile these
+// stages again (core/solver_stages_impl.hpp holds the definitions).
+#pragma once
+
+#include <utility>
+#include <vector>
+
+#include "core/nonlocal.hpp"
+#include "core/particle_blocks.hpp"
+#include "core/stepper.hpp"
+#include "core/tensor_transfer.hpp"
+
+namespace mpmtb {
+
+// kFold: the P2G sums hold (m_i, p_i + dt f_i), the force folded into the
+// momentum (NodeSums, TensorTransfer::scatter_folded).
+template <int Dim, class Kernel, bool kFold>
+class SolverStages : public Stepper<Dim> {
+ public:
+  // tensor_path: the transfer's momentum goes through the P2G sums (its policy
+  // declares the tensor-product form, core/tensor_transfer.hpp), so that the
+  // force part of the split P2G adds to the momentum sums scatter_momentum left.
+  explicit SolverStages(bool tensor_path) : tensor_path_(tensor_path) {}
+
+  // The stages are never inlined: their code is emitted once, in the file that
+  // instantiates them (instantiate()), whatever the optimiser decides there.
+  // They run once per step, so the call costs nothing.
+  [[gnu::noinline]] void scatter_forces(State<Dim>& s, Real dt) override;
+  [[gnu::noinline]] void grid_velocities(State<Dim>& s, Real t) override;
+  [[gnu::noinline]] StepReport update_deformation(State<Dim>& s, Real dt) override;
+  [[gnu::noinline]] void nonlocal_update(State<Dim>& s) override;
+
+  // Instantiates every stage for this combination (core/solver_stages_*d.cpp).
+  static void instantiate(SolverStages& self, State<Dim>& s);
+
+ protected:
+  using StencilT = Stencil<Dim, Kernel>;
+  using Sums = TensorTransfer<Dim, Kernel>;
+
+  // V0_p tau_p of every particle, from the materials, into tauV_.
+  [[gnu::noinline]] void compute_stresses(const State<Dim>& s);
+  // Zeroes every nodal field over the active box of the previous step: the grid
+  // is zero everywhere before the scatter, at a cost that follows the particles.
+  [[gnu::noinline]] void clear_active_box(Grid<Dim>& g);
+  // The active box and P2G's blocks for the particles' positions.
+  [[gnu::noinline]] void bin(State<Dim>& s);
+  // m_i, p_i, f_i <- the scatter's sums over the active box (NodeSums::unpack),
+  // the sums then zeroed (drained) or kept for scatter_forces.
+  [[gnu::noinline]] void unpack_and_drain(Grid<Dim>& g);
+  [[gnu::noinline]] void unpack_and_keep(Grid<Dim>& g);
+
+  // The form into the P2G sums, folded with dt or not (kFold).
+  template <TensorTerms T>
+  void add_form(const StencilT& st, const GridGeometry<Dim>& geo, const ScatterForm<Dim>& form,
+                Real dt) {
+    if constexpr (kFold) {
+      Sums::template scatter_folded<T>(st, geo, form, dt, sums_.data());
+    } else {
+      Sums::template scatter<T>(st, geo, form, sums_.data());
+    }
+  }
+
+  // The gathers' input: v and v_old (if the rows hold it) packed over the active
+  // box (VelocityRows), which holds every stencil of the particles that scattered.
+  template <class Rows>
+  static void pack_velocities(Rows& rows_out, const Grid<Dim>& g, const Vec<Dim>* v,
+                              const Vec<Dim>* v_old) {
+    rows_out.resize(g.size());
+    for_each_active_row(g, [&](long first, long count) { rows_out.pack(first, count, v, v_old); });
+  }
+
+  // f(first, count) for every row of the active box (runs of consecutive nodes
+  // along the last axis), in parallel.
+  template <class F>
+  static void for_each_active_row(const Grid<Dim>& g, F&& f) {
+    g.active.for_each_row(g.geo.strides(), f);
+  }
+  // f(node) for every node of the active box, in parallel over its rows.
+  template <class F>
+  static void for_each_active_node(const Grid<Dim>& g, F&& f) {
+    g.active.for_each_node(g.geo.strides(), f);
+  }
+
+  std::vector<Mat<Dim>> tauV_;       // V0_p tau_p, from the materials
+  NodeSums<Dim, kFold> sums_;        // the fast path's P2G accumulator
+  bool sums_kept_ = false;           // sums_ holds scatter_momentum's sums (see clear_active_box)
+  VelocityRows<Dim, false> v_rows_;  // v alone: the F update, XPIC's filter
+  ParticleBlocks<Dim, Kernel> blocks_;  // P2G's colouring (core/particle_blocks.hpp)
+
+ private:
+  // f_i += -V0_p tau_p grad w_ip + w_ip m_p b_p for particle p.
+  void scatter_force(State<Dim>& s, int p, Real dt);
+
+  bool tensor_path_;
+  std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
+  std::vector<Vec<Dim>> p_kept_;
+  NonlocalLaplacian<Dim, Kernel> nonlocal_;
+};
+
+}  // namespace mpmtb

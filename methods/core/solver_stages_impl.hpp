@@ -1,0 +1,180 @@
+// Definitions of the transfer-independent stages (core/solver_stages.hpp).
+// Included only by core/solver_stages_*d.cpp, which instantiate them for every
+// kernel of their dimension.
+#pragma once
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+#include "core/solver_stages.hpp"
+#include "kernels/all.hpp"
+
+namespace mpmtb {
+
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::compute_stresses(const State<Dim>& s) {
+  tauV_.resize(s.particles.size());
+  for (std::size_t m = 0; m < s.materials.size(); ++m) {
+    s.materials[m]->kirchhoff_times_volume(s.particles, s.material_particles[m], tauV_);
+  }
+}
+
+// The scatter's sums are zero outside the calls that fill and drain them, but
+// for those that scatter_momentum kept and no scatter_forces drained (musl).
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::clear_active_box(Grid<Dim>& g) {
+  sums_.resize(g.size());
+  const bool clear_sums = std::exchange(sums_kept_, false);
+  for_each_active_row(g, [&](long first, long count) {
+    std::fill_n(g.m.begin() + first, count, Real(0));
+    std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
+    if (clear_sums) sums_.clear(first, count);
+  });
+}
+
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::bin(State<Dim>& s) {
+  blocks_.bin(s);
+}
+
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::unpack_and_drain(Grid<Dim>& g) {
+  for_each_active_row(g, [&](long first, long count) {
+    sums_.template unpack<true, true>(first, count, g.m.data(), g.p.data(), g.f.data());
+  });
+}
+
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::unpack_and_keep(Grid<Dim>& g) {
+  for_each_active_row(g, [&](long first, long count) {
+    sums_.template unpack<true, false>(first, count, g.m.data(), g.p.data(), g.f.data());
+  });
+}
+
+// Force, on the blocks scatter_momentum binned (the particles have not moved),
+// added to the momentum sums that scatter_momentum left (tensor path), or alone
+// in the sums (per-node path, whose momentum went straight to the grid).
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::scatter_forces(State<Dim>& s, Real dt) {
+  compute_stresses(s);
+  blocks_.for_each_coloured(s, [&](int p) { scatter_force(s, p, dt); });
+  Grid<Dim>& g = s.grid;
+  if (kFold || tensor_path_) {
+    unpack_and_drain(g);
+  } else if constexpr (!kFold) {
+    for_each_active_row(g, [&](long first, long count) {
+      sums_.template unpack<false, true>(first, count, g.m.data(), g.p.data(), g.f.data());
+    });
+  }
+  sums_kept_ = false;
+}
+
+// f_i += -V0_p tau_p grad w_ip + w_ip m_p b_p: the force of a gradient-based
+// transfer (Sulsky et al. 1994), the force part of the split P2G.
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::scatter_force(State<Dim>& s, int p, Real dt) {
+  const Particles<Dim>& P = s.particles;
+  using Form = ScatterForm<Dim>;
+  Form form;
+  for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(Form::f) = -tauV_[p].col(a);
+  if (s.body_force) form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
+  add_form<TensorTerms{.gradient = true}>(StencilT(P.x[p], s.grid.geo), s.grid.geo, form, dt);
+}
+
+// v_i = p_i / m_i with walls, pinned nodes and colliders, for the F update.
+// Folding the walls' ghosts changes m and p, which the grid update that may
+// follow (usf) folds again, so they are kept and restored; no impulse is
+// exchanged with the boundaries here, so none is recorded.
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::grid_velocities(State<Dim>& s, Real t) {
+  Grid<Dim>& g = s.grid;
+  m_kept_.resize(g.m.size());
+  p_kept_.resize(g.p.size());
+  for_each_active_row(g, [&](long first, long count) {
+    std::copy_n(g.m.begin() + first, count, m_kept_.begin() + first);
+    std::copy_n(g.p.begin() + first, count, p_kept_.begin() + first);
+  });
+  s.walls.fold(g);
+  for_each_active_node(g, [&](long i) {
+    if (g.m[i] > 0 && !g.pinned[i]) {
+      g.v[i] = g.p[i] / g.m[i];
+    } else {
+      g.v[i].setZero();
+    }
+  });
+  s.walls.apply(g);
+  if (!s.colliders.empty()) {
+    Vec3 impulse = Vec3::Zero();
+    Real work = 0;
+    s.colliders.apply(g, t, impulse, work);
+  }
+  for_each_active_row(g, [&](long first, long count) {
+    std::copy_n(m_kept_.begin() + first, count, g.m.begin() + first);
+    std::copy_n(p_kept_.begin() + first, count, g.p.begin() + first);
+  });
+}
+
+// F_p <- (I + dt sum_i v_i grad w_ip^T) F_p, the F update of every
+// gradient-based transfer (Sulsky et al. 1994), from the grid's v.
+template <int Dim, class Kernel, bool kFold>
+StepReport SolverStages<Dim, Kernel, kFold>::update_deformation(State<Dim>& s, Real dt) {
+  Particles<Dim>& P = s.particles;
+  const Grid<Dim>& g = s.grid;
+  pack_velocities(v_rows_, g, g.v.data(), nullptr);
+  const long n = static_cast<long>(P.size());
+  Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min;
+  long non_finite = n;
+#pragma omp parallel for schedule(static) reduction(min                  \
+                                                    : J_min, non_finite) \
+    reduction(max                                                        \
+              : J_max) if (n >= kParallelMinimum)
+  for (long p = 0; p < n; ++p) {
+    const StencilT st(P.x[p], g.geo);
+    const Mat<Dim> G =
+        Sums::template gather<TensorTerms{.gradient = true}>(st, g.geo, v_rows_.data()).G;
+    P.F[p] = (Mat<Dim>::Identity() + dt * G) * P.F[p];
+    const Real J = P.F[p].determinant();
+    J_min = std::min(J_min, J);
+    J_max = std::max(J_max, J);
+    if (!std::isfinite(J)) non_finite = std::min(non_finite, p);
+  }
+  return {J_min, J_max, 0, non_finite == n ? -1 : non_finite, -1};
+}
+
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::nonlocal_update(State<Dim>& s) {
+  nonlocal_.apply(s);
+}
+
+// Never called: a qualified (non-virtual) call of each stage instantiates it
+// here, and, not inlined, its code is emitted for the solvers of every transfer
+// to link against.
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::instantiate(SolverStages& self, State<Dim>& s) {
+  using S = SolverStages;
+  self.S::scatter_forces(s, 0);
+  self.S::grid_velocities(s, 0);
+  self.S::update_deformation(s, 0);
+  self.S::nonlocal_update(s);
+  self.S::compute_stresses(s);
+  self.S::clear_active_box(s.grid);
+  self.S::bin(s);
+  self.S::unpack_and_drain(s.grid);
+  self.S::unpack_and_keep(s.grid);
+}
+
+// Every kernel's stages in dimension Dim, with both layouts of the sums.
+template <int Dim>
+void instantiate_solver_stages() {
+  AllKernels::for_each([]<class K>() {
+    [[maybe_unused]] volatile auto folded = &SolverStages<Dim, K, true>::instantiate;
+    [[maybe_unused]] volatile auto unfolded = &SolverStages<Dim, K, false>::instantiate;
+  });
+}
+
+}  // namespace mpmtb
