@@ -71,14 +71,27 @@ mkdir -p "$daemons"/{state,spool,log,munge}
 chmod 700 "$daemons/munge"
 pids=()
 stop_daemons() {
-  local p
-  # Only this test's jobs live on this private cluster (SLURM_CONF is ours).
+  local f p running=()
+  # Only this test's jobs live on this private cluster (SLURM_CONF is ours):
+  # cancel them and give their steps a moment to end before slurmd goes.
   if [ -s "$daemons/slurmctld.pid" ]; then
-    scancel --user="$(id -un)" 2>/dev/null && sleep 1 || true
+    scancel --user="$(id -un)" 2>/dev/null || true
+    for _ in $(seq 1 10); do
+      [ -z "$(squeue -h 2>/dev/null)" ] && break
+      sleep 1
+    done
   fi
   for f in "${pids[@]}"; do
-    [ -s "$f" ] && p=$(cat "$f") && kill "$p" 2>/dev/null || true
+    [ -s "$f" ] && p=$(cat "$f") && kill "$p" 2>/dev/null && running+=("$p") || true
   done
+  # slurmd waits for steps that a failed test left behind: not for ever.
+  for _ in $(seq 1 10); do
+    local alive=0
+    for p in "${running[@]}"; do kill -0 "$p" 2>/dev/null && alive=1; done
+    [ "$alive" -eq 0 ] && return 0
+    sleep 1
+  done
+  for p in "${running[@]}"; do kill -9 "$p" 2>/dev/null || true; done
 }
 trap stop_daemons EXIT
 dd if=/dev/urandom of="$daemons/munge/munge.key" bs=1024 count=1 status=none
