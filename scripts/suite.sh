@@ -39,6 +39,12 @@ rm -rf results/pinned_block/3d
 # The suites (convergence, stability, speed-accuracy) at the quick level: every
 # transfer x kernel, one run per child process, resumable (results/suites).
 "$mpmtb" suite all --quick --out results/suites
+# The suites on a real scheduler: the quick convergence suite as 3 shards under
+# GNU parallel and as a Slurm job array on a single-node Slurm that the test
+# starts and stops, tables compared byte for byte with a local run (ctest label
+# `cluster`, a few minutes; skipped with the reason where Slurm cannot start).
+bash scripts/setup-deps.sh --cluster
+(cd build && ctest -L cluster --output-on-failure)
 bash scripts/gallery.sh
 /usr/bin/python3 analysis/plot_all.py --results results
 echo "mpmtb: results in results/README.md"

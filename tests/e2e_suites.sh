@@ -9,6 +9,9 @@
 #   resume:    a quick convergence suite killed with SIGKILL mid-run and run
 #              again gives the same tables as an uninterrupted one and reruns
 #              only the unfinished runs.
+#   shards:    the same suite as 3 shards (--shard K/N), in any order, repeated,
+#              one stopped by SIGTERM and re-run, then --collect: the same
+#              tables byte for byte, the shards disjoint and covering.
 set -euo pipefail
 mode=$1 mpmtb=$2 work=$3
 rm -rf "$work" && mkdir -p "$work"
@@ -142,8 +145,73 @@ resume)
   done
   echo "resume: killed after $finished of $total runs; resumed tables identical"
   ;;
+shards)
+  # A suite split into 3 shards, run out of order, one twice, one stopped by
+  # SIGTERM (as a batch system's time limit does, to every process of the job)
+  # and run again, then collected: the tables equal one local run's byte for
+  # byte, and the shards' runs are disjoint and cover the list.
+  args=(suite convergence --quick --case bar --transfer mls --transfer pic)
+  "$mpmtb" "${args[@]}" --jobs 2 --quiet --out "$work/local"
+  total=$(find "$work/local/convergence/runs" -name done.json | wc -l)
+  out=$work/sharded
+  expect_status() {  # status command...: runs the command, checks its exit status
+    local want=$1 got=0
+    shift
+    "$@" || got=$?
+    [ "$got" -eq "$want" ] || { echo "exit status $got, expected $want: $*"; exit 1; }
+  }
+  for bad in 4/3 0/3 x 3 1/0 2/3x; do
+    expect_status 2 "$mpmtb" "${args[@]}" --shard "$bad" --out "$work/bad" 2>"$work/err"
+    grep -q -- "--shard '$bad'" "$work/err" || { echo "no field named:"; cat "$work/err"; exit 1; }
+  done
+  expect_status 2 "$mpmtb" "${args[@]}" --shard 1/3 --collect --out "$work/bad" 2>"$work/err"
+  [ ! -e "$work/bad" ] || { echo "bad input wrote $work/bad"; exit 1; }
+  # Nothing has run: --collect lists every run and writes no table.
+  expect_status 4 "$mpmtb" "${args[@]}" --collect --out "$out" 2>"$work/collect0.log"
+  [ "$(grep -c ': no done.json$' "$work/collect0.log")" -eq "$total" ] ||
+    { echo "collect did not list all $total runs:"; head "$work/collect0.log"; exit 1; }
+  [ ! -e "$out/convergence/orders.csv" ] || { echo "tables written with runs missing"; exit 1; }
+  "$mpmtb" "${args[@]}" --shard 3/3 --jobs 2 --out "$out" 2>"$work/shard3.log"
+  "$mpmtb" "${args[@]}" --shard 1/3 --jobs 2 --out "$out" 2>"$work/shard1.log"
+  "$mpmtb" "${args[@]}" --shard 1/3 --jobs 2 --out "$out" 2>"$work/shard1b.log"
+  runs_of() { sed -n 's/.*shard [0-9]\/3: \([0-9]*\) runs:.*/\1/p' "$1"; }
+  n1=$(runs_of "$work/shard1.log") n3=$(runs_of "$work/shard3.log")
+  grep -q "$n1 runs: $n1 finished before, 0 to run" "$work/shard1b.log" ||
+    { echo "shard 1 run twice redid runs:"; cat "$work/shard1b.log"; exit 1; }
+  expect_status 4 "$mpmtb" "${args[@]}" --collect --out "$out" 2>"$work/collect1.log"
+  [ "$(grep -c ': no done.json$' "$work/collect1.log")" -eq $((total - n1 - n3)) ] ||
+    { echo "collect should list the $((total - n1 - n3)) runs of shard 2"; exit 1; }
+  # Shard 2, one run at a time, stopped by SIGTERM to its whole process group.
+  before=$(find "$out/convergence/runs" -name done.json | wc -l)
+  setsid "$mpmtb" "${args[@]}" --shard 2/3 --jobs 1 --out "$out" 2>"$work/shard2.log" &
+  pid=$!
+  for _ in $(seq 1 1000); do
+    [ "$(find "$out/convergence/runs" -name done.json | wc -l)" -ge $((before + 3)) ] && break
+    sleep 0.01
+  done
+  kill -TERM -- -"$pid"
+  got=0
+  wait "$pid" || got=$?
+  [ "$got" -eq 143 ] || { echo "shard 2 after SIGTERM: status $got, expected 143"; exit 1; }
+  find "$out/convergence/runs" -name done.json | sort | xargs md5sum >"$work/before.md5"
+  kept=$(wc -l <"$work/before.md5")
+  [ "$kept" -lt "$total" ] || { echo "shard 2 finished before SIGTERM"; exit 1; }
+  "$mpmtb" "${args[@]}" --shard 2/3 --jobs 2 --out "$out" 2>"$work/shard2b.log"
+  n2=$(runs_of "$work/shard2b.log")
+  md5sum --quiet -c "$work/before.md5" || { echo "a finished run was redone"; exit 1; }
+  [ $((n1 + n2 + n3)) -eq "$total" ] ||
+    { echo "shards hold $n1 + $n2 + $n3 runs, the suite $total"; exit 1; }
+  [ "$(find "$out/convergence/runs" -name done.json | wc -l)" -eq "$total" ] ||
+    { echo "the shards' runs overlap or miss some"; exit 1; }
+  "$mpmtb" "${args[@]}" --collect --quiet --out "$out"
+  for t in bar.csv bar_dt.csv orders.csv; do
+    cmp "$work/local/convergence/$t" "$out/convergence/$t" || { echo "$t differs"; exit 1; }
+  done
+  echo "shards: $n1 + $n2 + $n3 = $total runs, shard 2 stopped by SIGTERM and resumed;" \
+    "collected tables identical to a local run"
+  ;;
 *)
-  echo "usage: e2e_suites.sh stability|resume MPMTB WORKDIR" >&2
+  echo "usage: e2e_suites.sh stability|resume|shards MPMTB WORKDIR" >&2
   exit 2
   ;;
 esac

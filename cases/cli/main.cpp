@@ -93,6 +93,14 @@ CLI::App* add_suite_command(CLI::App& app, mpmtb::SuiteRequest& r) {
   cmd->add_option("--case", r.cases, "only these cases (repeatable)");
   cmd->add_option("--transfer", r.transfers, "only these transfers (repeatable)");
   cmd->add_option("--kernel", r.kernels, "only these kernels (repeatable)");
+  auto* shard = cmd->add_option(
+      "--shard", r.shard,
+      "K/N: run only the K-th of N disjoint parts of the run list (balanced by estimated cost), "
+      "write no tables; every shard and --collect take the same NAME, level, filters and --out");
+  cmd->add_flag("--collect", r.collect,
+                "run nothing: write the tables once every run has its done.json, otherwise list "
+                "the missing runs and exit with status 4")
+      ->excludes(shard);
   return cmd;
 }
 

@@ -6,6 +6,7 @@
 #include <sys/wait.h>
 #include <unistd.h>
 
+#include <algorithm>
 #include <chrono>
 #include <csignal>
 #include <cstring>
@@ -27,8 +28,8 @@ using Clock = std::chrono::steady_clock;
 constexpr const char* kMarker = "done.json";
 
 volatile std::sig_atomic_t g_stop = 0;
-extern "C" void on_stop_signal(int) {
-  g_stop = 1;
+extern "C" void on_stop_signal(int sig) {
+  g_stop = sig;
 }
 
 // Installs SIGINT/SIGTERM handlers for the lifetime of a run_all call.
@@ -217,18 +218,56 @@ RunResult settle(const RunSpec& spec, const fs::path& dir, int wait_status, bool
   return r;
 }
 
-// A finished run: its marker exists and records the same arguments and git
+// What defines a run: its arguments less the value of --out. The folder is the
+// run's identity already, and a suite folder on a shared filesystem may be
+// mounted under another path on another host (or given relative there).
+nlohmann::json definition(std::vector<std::string> args) {
+  const auto out = std::find(args.begin(), args.end(), "--out");
+  if (out != args.end() && out + 1 != args.end()) args.erase(out + 1);
+  return args;
+}
+
+nlohmann::json recorded_definition(const nlohmann::json& recorded) {
+  if (!recorded.is_array()) return recorded;
+  std::vector<std::string> args;
+  for (const auto& a : recorded) {
+    if (!a.is_string()) return recorded;
+    args.push_back(a.get<std::string>());
+  }
+  return definition(args);
+}
+
+// A finished run: its marker exists and records the same definition and git
 // revision (a run left by an earlier suite definition or build is redone).
-std::optional<RunResult> finished(const RunSpec& spec, const fs::path& dir) {
+RunCheck check_marker(const RunSpec& spec, const fs::path& dir) {
   auto marker = read_json(dir / kMarker);
-  if (!marker || !marker->contains("status")) return std::nullopt;
-  if (marker->value("arguments", nlohmann::json()) != nlohmann::json(spec.arguments(dir)) ||
-      marker->value("revision", "") != build_info().git_revision) {
-    return std::nullopt;
+  if (!marker || !marker->contains("status")) return {std::nullopt, "no done.json"};
+  const std::string revision = marker->value("revision", "");
+  if (revision != build_info().git_revision) {
+    return {std::nullopt, fmt::format("done.json of revision {}, this build is {}", revision,
+                                      build_info().git_revision)};
+  }
+  if (recorded_definition(marker->value("arguments", nlohmann::json())) !=
+      definition(spec.arguments(dir))) {
+    return {std::nullopt, "done.json of other arguments (the suite's definition changed)"};
   }
   auto summary = read_json(dir / "summary.json");
-  if (!summary) return std::nullopt;
-  return RunResult{marker->value("status", ""), marker->value("reason", ""), *summary};
+  if (!summary) return {std::nullopt, "done.json but no readable summary.json"};
+  return {RunResult{marker->value("status", ""), marker->value("reason", ""), *summary}, ""};
+}
+
+// A child stopped by SIGINT or SIGTERM (mpmtb run stops cleanly with 130 or
+// 143): unfinished, not a result. Returns the signal, or 0.
+int stop_signal_of(int wait_status) {
+  if (WIFEXITED(wait_status)) {
+    const int code = WEXITSTATUS(wait_status);
+    return code == 128 + SIGINT ? SIGINT : code == 128 + SIGTERM ? SIGTERM : 0;
+  }
+  if (WIFSIGNALED(wait_status)) {
+    const int sig = WTERMSIG(wait_status);
+    return sig == SIGINT || sig == SIGTERM ? sig : 0;
+  }
+  return 0;
 }
 
 }  // namespace
@@ -250,7 +289,7 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
   std::vector<RunResult> results(specs.size());
   std::deque<std::size_t> pending;
   for (std::size_t i = 0; i < specs.size(); ++i) {
-    if (auto r = finished(specs[i], root / specs[i].dir)) {
+    if (auto r = check_marker(specs[i], root / specs[i].dir).result) {
       results[i] = std::move(*r);
     } else {
       pending.push_back(i);
@@ -273,7 +312,7 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
       for (const auto& [pid, c] : running) ::kill(pid, SIGKILL);
       for (const auto& [pid, c] : running) ::waitpid(pid, nullptr, 0);
       progress.finish(ran);
-      throw Interrupted();
+      throw Interrupted(g_stop);
     }
     while (!pending.empty() && static_cast<int>(running.size()) < jobs) {
       const std::size_t i = pending.front();
@@ -289,6 +328,12 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
       // A child that the same Ctrl-C stopped (mpmtb run stops cleanly on
       // SIGINT) is unfinished, not a result: the resumed suite runs it again.
       if (g_stop) continue;
+      // A child stopped first: a batch system's time limit signals every
+      // process of the job, and the suite stops with it.
+      if (const int sig = stop_signal_of(status)) {
+        g_stop = sig;
+        continue;
+      }
       const double seconds = std::chrono::duration<double>(Clock::now() - c.start).count();
       results[c.index] =
           settle(specs[c.index], root / specs[c.index].dir, status, c.timed_out, seconds);
@@ -308,6 +353,10 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
   }
   progress.finish(ran);
   return results;
+}
+
+RunCheck check_run(const RunSpec& spec, const fs::path& root) {
+  return check_marker(spec, root / spec.dir);
 }
 
 std::string failure_kind(const RunResult& r) {

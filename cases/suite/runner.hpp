@@ -30,6 +30,8 @@ struct RunSpec {
   std::filesystem::path dir;      // the run's folder, relative to the suite root
   // Free-form labels copied into the tables (level, study, ...).
   nlohmann::json tags = nlohmann::json::object();
+  // Estimated work (suite::CostModel), only to balance shards.
+  double cost = 1;
 
   std::vector<std::string> arguments(const std::filesystem::path& out) const;
 };
@@ -52,15 +54,26 @@ struct RunnerStats {
   int total = 0, finished_before = 0, ran = 0;
 };
 
-// Thrown when SIGINT or SIGTERM stops the suite; unfinished runs keep no marker.
+// Thrown when SIGINT or SIGTERM stops the suite (or one of its runs: a batch
+// system's time limit signals every process of the job); unfinished runs keep
+// no marker.
 struct Interrupted : std::runtime_error {
-  Interrupted() : std::runtime_error("interrupted") {}
+  explicit Interrupted(int sig) : std::runtime_error("interrupted"), signal(sig) {}
+  int signal;  // SIGINT or SIGTERM
 };
 
 // Runs every spec not yet finished under `root`, then returns every result in
 // the order of `specs`.
 std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const std::filesystem::path& root,
                                const RunnerOptions& options, RunnerStats* stats = nullptr);
+
+// A run's state on disk: its result when its marker is there and records the
+// same definition and git revision, otherwise why it counts as not finished.
+struct RunCheck {
+  std::optional<RunResult> result;
+  std::string missing;  // "no done.json", "done.json of revision ...", ...
+};
+RunCheck check_run(const RunSpec& spec, const std::filesystem::path& root);
 
 // The failure class of an unstable or crashed run's reason: nan, J<=0,
 // left-domain, energy-growth, crashed, invalid, or empty for ok runs.

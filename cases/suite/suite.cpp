@@ -6,15 +6,16 @@
 #include <fstream>
 #include <map>
 #include <sstream>
-#include <thread>
 
 #include "analysis.hpp"
 #include "cases.hpp"
 #include "core/registry.hpp"
 #include "output.hpp"
+#include "plan.hpp"
 #include "runner.hpp"
 #include "scene.hpp"
 #include "setup.hpp"
+#include "shard.hpp"
 
 namespace mpmtb {
 namespace {
@@ -22,6 +23,7 @@ namespace {
 namespace fs = std::filesystem;
 using nlohmann::json;
 using suite::kNaN;
+using suite::Plan;
 using suite::RunResult;
 using suite::RunSpec;
 
@@ -122,18 +124,6 @@ double wave_speed(const Scene& s) {
   }
 }
 
-suite::RunnerOptions runner_options(const SuiteRequest& r, const std::string& title) {
-  suite::RunnerOptions o;
-  o.jobs = r.jobs > 0 ? r.jobs : std::max(1u, std::thread::hardware_concurrency());
-  o.quiet = r.quiet;
-  o.title = title;
-  return o;
-}
-
-void note(const SuiteRequest& r, const std::string& text) {
-  if (!r.quiet) fmt::print(stderr, "{}\n", text);
-}
-
 // --------------------------------------------------------- convergence --
 
 // One refinement series: a method on a case, grid or time-step study.
@@ -165,6 +155,7 @@ void plan_refinement(const SuiteRequest& r, const suite::ConvergenceCase& c, boo
   const double t_end = r.full ? c.t_end_full : c.t_end_quick;
   const int dt_cells = dt_study ? (r.full ? c.dt_cells_full : c.dt_cells_quick) : 0;
   const Scene base = load_scene(c.scene, overrides_for(c.scene, c.dim, 8, c.sets));
+  const suite::CostModel model(base);
   double dt0 = kNaN;
   if (dt_cells > 0) {
     const Scene s = load_scene(c.scene, overrides_for(c.scene, c.dim, dt_cells, c.sets));
@@ -177,6 +168,7 @@ void plan_refinement(const SuiteRequest& r, const suite::ConvergenceCase& c, boo
       RunSpec s = make_spec(c.name, c.scene, c.dim, m, cells[k], t_end, c.sets);
       s.cfl = c.cfl;
       s.dir = fs::path("runs") / c.name / m.name() / fmt::format("L{}", k);
+      s.cost = model.cost(s);
       g.runs.push_back(specs.size());
       g.h.push_back(base.length / cells[k]);
       specs.push_back(std::move(s));
@@ -188,6 +180,7 @@ void plan_refinement(const SuiteRequest& r, const suite::ConvergenceCase& c, boo
       RunSpec s = make_spec(c.name, c.scene, c.dim, m, dt_cells, t_end, c.sets);
       s.dt = dt0 / (1 << k);
       s.dir = fs::path("runs") / c.name / m.name() / fmt::format("dt{}", k);
+      s.cost = model.cost(s);
       d.runs.push_back(specs.size());
       d.h.push_back(base.length / dt_cells);
       d.dt.push_back(*s.dt);
@@ -242,17 +235,16 @@ void write_convergence_tables(const fs::path& root, const std::vector<Series>& s
   orders.write(root / "orders.csv");
 }
 
-int run_convergence(const SuiteRequest& r) {
-  const fs::path root = fs::path(r.out) / "convergence";
-  std::vector<RunSpec> specs;
+Plan plan_convergence(const SuiteRequest& r) {
+  Plan p{"convergence", fs::path(r.out) / "convergence", {}, {}};
   std::vector<Series> series;
   for (const auto& c : suite::convergence_cases()) {
-    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, true, specs, series);
+    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, true, p.specs, series);
   }
-  const auto results = suite::run_all(specs, root, runner_options(r, "suite convergence"));
-  write_convergence_tables(root, series, results);
-  note(r, fmt::format("suite convergence: tables in {}", root.string()));
-  return 0;
+  p.write_tables = [root = p.root, series = std::move(series)](const auto& results) {
+    write_convergence_tables(root, series, results);
+  };
+  return p;
 }
 
 // ------------------------------------------------------------ stability --
@@ -353,12 +345,33 @@ void write_stability_tables(const fs::path& root, const std::vector<Sweep>& swee
   stable.write(root / "stable_cfl.csv");
 }
 
-int run_stability(const SuiteRequest& r) {
-  const fs::path root = fs::path(r.out) / "stability";
-  std::vector<RunSpec> specs;
+// A failure mode shown on purpose: one method on a case, and its metric.
+struct Mode {
+  std::string case_name, metric;
+  Method method;
+  std::size_t run;
+};
+
+void write_failure_modes(const fs::path& root, const std::vector<RunSpec>& specs,
+                         const std::vector<Mode>& modes, const std::vector<RunResult>& results) {
+  Table t{{"case", "metric", "transfer", "kernel", "status", "value", "reason"}, {}};
+  for (const Mode& m : modes) {
+    const RunResult& res = results[m.run];
+    t.rows.push_back({m.case_name, m.metric, m.method.transfer, m.method.kernel, res.status,
+                      num(failure_metric(m.metric, root / specs[m.run].dir, res)),
+                      res.status == "ok" ? "" : res.reason});
+  }
+  if (!modes.empty()) t.write(root / "failure_modes.csv");
+}
+
+Plan plan_stability(const SuiteRequest& r) {
+  Plan p{"stability", fs::path(r.out) / "stability", {}, {}};
+  std::vector<RunSpec>& specs = p.specs;
   std::vector<Sweep> sweeps;
   for (const auto& c : suite::stability_cases()) {
     if (!runnable(r, c.name, c.scene)) continue;
+    const suite::CostModel model(
+        load_scene(c.scene, overrides_for(c.scene, c.dim, c.cells, c.sets)));
     const auto grid = cfl_grid(c, r.full);
     for (const Method& m : methods(r)) {
       for (int ppc : r.full ? c.full_ppc : c.quick_ppc) {
@@ -369,6 +382,7 @@ int run_stability(const SuiteRequest& r) {
           spec.cfl = cfl;
           spec.dir =
               fs::path("runs") / c.name / m.name() / fmt::format("ppc{}-cfl{:.3f}", ppc, cfl);
+          spec.cost = model.cost(spec);
           s.runs.push_back(specs.size());
           specs.push_back(std::move(spec));
         }
@@ -377,48 +391,34 @@ int run_stability(const SuiteRequest& r) {
     }
   }
   // Failure modes shown on purpose, every method on each case.
-  struct Mode {
-    std::string case_name, metric;
-    Method method;
-    std::size_t run;
-  };
   std::vector<Mode> modes;
   for (const auto& c : suite::failure_mode_cases()) {
     if (!runnable(r, c.name, c.scene)) continue;
     const Scene base = load_scene(c.scene, {});
+    const int cells = c.cells > 0 ? c.cells : base.cells;
+    const suite::CostModel model(load_scene(c.scene, overrides_for(c.scene, c.dim, cells, c.sets)));
     for (const Method& m : methods(r)) {
-      RunSpec spec =
-          make_spec(c.name, c.scene, c.dim, m, c.cells > 0 ? c.cells : base.cells, c.t_end, c.sets);
+      RunSpec spec = make_spec(c.name, c.scene, c.dim, m, cells, c.t_end, c.sets);
       spec.ppc = base.ppc;
       spec.dir = fs::path("runs") / "failure_modes" / c.name / m.name();
+      spec.cost = model.cost(spec);
       modes.push_back({c.name, c.metric, m, specs.size()});
       specs.push_back(std::move(spec));
     }
   }
-  const auto results = suite::run_all(specs, root, runner_options(r, "suite stability"));
-  write_stability_tables(root, sweeps, results);
-  Table t{{"case", "metric", "transfer", "kernel", "status", "value", "reason"}, {}};
-  for (const Mode& m : modes) {
-    const RunResult& res = results[m.run];
-    t.rows.push_back({m.case_name, m.metric, m.method.transfer, m.method.kernel, res.status,
-                      num(failure_metric(m.metric, root / specs[m.run].dir, res)),
-                      res.status == "ok" ? "" : res.reason});
-  }
-  if (!modes.empty()) t.write(root / "failure_modes.csv");
-  note(r, fmt::format("suite stability: tables in {}", root.string()));
-  return 0;
+  p.write_tables = [root = p.root, specs = p.specs, sweeps = std::move(sweeps),
+                    modes = std::move(modes)](const auto& results) {
+    write_stability_tables(root, sweeps, results);
+    write_failure_modes(root, specs, modes, results);
+  };
+  return p;
 }
 
 // ------------------------------------------------------- speed-accuracy --
 
-int run_speed_accuracy(const SuiteRequest& r) {
-  const fs::path root = fs::path(r.out) / "speed_accuracy";
-  std::vector<RunSpec> specs;
-  std::vector<Series> series;
-  for (const auto& c : suite::speed_accuracy_cases()) {
-    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, false, specs, series);
-  }
-  const auto results = suite::run_all(specs, root, runner_options(r, "suite speed-accuracy"));
+// The Pareto tables: error against wall time and against particle-steps.
+void write_speed_tables(const fs::path& root, const std::vector<Series>& series,
+                        const std::vector<RunResult>& results) {
   std::map<std::string, std::vector<const Series*>> by_case;
   for (const auto& g : series) by_case[g.case_name].push_back(&g);
   for (const auto& [name, groups] : by_case) {
@@ -453,23 +453,32 @@ int run_speed_accuracy(const SuiteRequest& r) {
     }
     t.write(root / (name + ".csv"));
   }
-  note(r, fmt::format("suite speed-accuracy: tables in {}", root.string()));
-  return 0;
+}
+
+Plan plan_speed_accuracy(const SuiteRequest& r) {
+  Plan p{"speed-accuracy", fs::path(r.out) / "speed_accuracy", {}, {}};
+  std::vector<Series> series;
+  for (const auto& c : suite::speed_accuracy_cases()) {
+    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, false, p.specs, series);
+  }
+  p.write_tables = [root = p.root, series = std::move(series)](const auto& results) {
+    write_speed_tables(root, series, results);
+  };
+  return p;
 }
 
 }  // namespace
 
-int command_suite(const SuiteRequest& request) {
-  try {
-    const std::string& n = request.name;
-    if (n == "convergence" || n == "all") run_convergence(request);
-    if (n == "stability" || n == "all") run_stability(request);
-    if (n == "speed-accuracy" || n == "all") run_speed_accuracy(request);
-  } catch (const suite::Interrupted&) {
-    fmt::print(stderr, "suite: interrupted; finished runs are kept, run again to resume\n");
-    return 130;
-  }
-  return 0;
+namespace suite {
+
+std::vector<Plan> plan_suites(const SuiteRequest& request) {
+  const std::string& n = request.name;
+  std::vector<Plan> plans;
+  if (n == "convergence" || n == "all") plans.push_back(plan_convergence(request));
+  if (n == "stability" || n == "all") plans.push_back(plan_stability(request));
+  if (n == "speed-accuracy" || n == "all") plans.push_back(plan_speed_accuracy(request));
+  return plans;
 }
 
+}  // namespace suite
 }  // namespace mpmtb

@@ -1,5 +1,6 @@
 // `mpmtb suite convergence|stability|speed-accuracy|all`: sweeps of whole runs,
-// each a child process in its own folder, resumable, with CSV tables.
+// each a child process in its own folder, resumable, with CSV tables; split
+// over machines with --shard K/N and put together with --collect.
 //
 // Layout under --out (default results/suites):
 //   convergence/<case>.csv, <case>_dt.csv, orders.csv
@@ -21,10 +22,21 @@ struct SuiteRequest {
   bool quiet = false;
   // Filters (empty: everything): case names, transfers, kernels.
   std::vector<std::string> cases, transfers, kernels;
+  // "K/N": run only the K-th of N disjoint parts of the run list, write no
+  // tables (cases/suite/shard.hpp). Empty: every run, then the tables.
+  std::string shard;
+  // Run nothing: write the tables from the runs on disk, once all are done.
+  bool collect = false;
 };
 
+// --collect found runs without their done.json (they are listed on stderr).
+constexpr int kExitIncomplete = 4;
+
 // Returns the exit status: 0 when every table was written (unstable runs are
-// data), 130 when interrupted by SIGINT/SIGTERM.
+// data) or, with a shard, when the shard's runs are done; 130 (SIGINT) or 143
+// (SIGTERM) when stopped; kExitIncomplete for --collect with runs missing.
+// Every shard and the collect step must be given the same name, level and
+// filters: they define the run list that the shards split.
 int command_suite(const SuiteRequest& request);
 
 }  // namespace mpmtb
