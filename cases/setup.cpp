@@ -121,4 +121,15 @@ template State<1> build_state<1>(const Scene&);
 template State<2> build_state<2>(const Scene&);
 template State<3> build_state<3>(const Scene&);
 
+double max_wave_speed(const Scene& s) {
+  switch (s.dim) {
+    case 1:
+      return build_state<1>(s).max_wave_speed();
+    case 2:
+      return build_state<2>(s).max_wave_speed();
+    default:
+      return build_state<3>(s).max_wave_speed();
+  }
+}
+
 }  // namespace mpmtb

@@ -17,4 +17,8 @@ GridGeometry<Dim> scene_grid(const Scene& scene);
 template <int Dim>
 State<Dim> build_state(const Scene& scene);
 
+// Largest wave speed c_p of the scene's materials, in its own dimension (the
+// CFL time step of the suites' fixed-dt studies and their cost estimates).
+double max_wave_speed(const Scene& scene);
+
 }  // namespace mpmtb

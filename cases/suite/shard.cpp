@@ -23,17 +23,6 @@ std::optional<int> whole_number(std::string_view text) {
   return v;
 }
 
-double wave_speed_of(const Scene& s) {
-  switch (s.dim) {
-    case 1:
-      return build_state<1>(s).max_wave_speed();
-    case 2:
-      return build_state<2>(s).max_wave_speed();
-    default:
-      return build_state<3>(s).max_wave_speed();
-  }
-}
-
 // Nodes per axis of a kernel's stencil; a kernel not listed counts as quadratic
 // (the estimate only balances shards, it never decides a result).
 double stencil_width(const std::string& kernel) {
@@ -92,7 +81,7 @@ CostModel::CostModel(const Scene& base)
     : dim_(base.dim),
       length_(base.length),
       t_end_(base.t_end),
-      wave_speed_(std::max<double>(wave_speed_of(base), 1e-300)),
+      wave_speed_(std::max<double>(max_wave_speed(base), 1e-300)),
       dt_(base.dt),
       cfl_(base.cfl) {
   const double lattice = std::pow(static_cast<double>(base.cells) * base.ppc, base.dim);

@@ -112,18 +112,6 @@ Overrides overrides_for(const std::string& /*scene*/, int dim, int cells,
   return o;
 }
 
-// Largest wave speed c_p of a scene's materials (for the fixed-dt study).
-double wave_speed(const Scene& s) {
-  switch (s.dim) {
-    case 1:
-      return build_state<1>(s).max_wave_speed();
-    case 2:
-      return build_state<2>(s).max_wave_speed();
-    default:
-      return build_state<3>(s).max_wave_speed();
-  }
-}
-
 // --------------------------------------------------------- convergence --
 
 // One refinement series: a method on a case, grid or time-step study.
@@ -159,7 +147,7 @@ void plan_refinement(const SuiteRequest& r, const suite::ConvergenceCase& c, boo
   double dt0 = kNaN;
   if (dt_cells > 0) {
     const Scene s = load_scene(c.scene, overrides_for(c.scene, c.dim, dt_cells, c.sets));
-    dt0 = c.dt_cfl * s.dx() / wave_speed(s);
+    dt0 = c.dt_cfl * s.dx() / max_wave_speed(s);
   }
   for (const Method& m : methods(r)) {
     Series g{c.name, "grid", c.error_key, m, {}, {}, {}};
