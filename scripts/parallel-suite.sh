@@ -23,13 +23,8 @@ usage() {
 [ $# -ge 2 ] || usage
 suite=$1 shards=$2
 shift 2
-case "$suite" in convergence | stability | speed-accuracy | all) ;; *)
-  echo "parallel-suite.sh: SUITE '$suite': allowed convergence, stability, speed-accuracy, all" >&2
-  exit 2
-  ;;
-esac
-[[ "$shards" =~ ^[1-9][0-9]*$ ]] ||
-  { echo "parallel-suite.sh: N '$shards': a whole number >= 1" >&2; exit 2; }
+source "$root/scripts/slurm/shard-args.sh"
+check_suite_and_shards parallel-suite.sh "$suite" "$shards"
 out=results/suites mpmtb=$root/build/cases/mpmtb jobs=1 hosts=()
 while [ $# -gt 0 ]; do
   case "$1" in

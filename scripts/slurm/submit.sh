@@ -24,12 +24,8 @@ usage() {
 [ $# -ge 2 ] || usage
 suite=$1 shards=$2
 shift 2
-case "$suite" in convergence | stability | speed-accuracy | all) ;; *)
-  echo "submit.sh: SUITE '$suite': allowed convergence, stability, speed-accuracy, all" >&2
-  exit 2
-  ;;
-esac
-[[ "$shards" =~ ^[1-9][0-9]*$ ]] || { echo "submit.sh: N '$shards': a whole number >= 1" >&2; exit 2; }
+source "$here/shard-args.sh"
+check_suite_and_shards submit.sh "$suite" "$shards"
 out=results/suites mpmtb=$root/build/cases/mpmtb cpus=1 sbatch_args="" figures=1
 while [ $# -gt 0 ]; do
   case "$1" in
