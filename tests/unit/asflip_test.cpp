@@ -15,7 +15,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace asflip_test {
 
 struct Body {
   State<2> s;
@@ -132,5 +132,5 @@ TEST(Asflip, ParametersOutOfRangeAreRejected) {
   }
 }
 
-}  // namespace
+}  // namespace asflip_test
 }  // namespace mpmtb

@@ -11,7 +11,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace cfl_test {
 
 constexpr Real kE = 1000, kNu = 0.3, kRho = 1000, kXi = 10;
 // P-wave speed of the unhardened material, from E, nu, rho directly.
@@ -62,5 +62,5 @@ TEST(CflWaveSpeed, AdaptiveStepShrinksWhenSnowHardens) {
   EXPECT_LT(dt_min, 0.5 * Real(r.summary["dt_max"])) << "the step must shrink as the snow hardens";
 }
 
-}  // namespace
+}  // namespace cfl_test
 }  // namespace mpmtb

@@ -10,7 +10,7 @@
 #include "models/registry.hpp"
 
 namespace mpmtb {
-namespace {
+namespace citations_test {
 
 // Braces balance and never close below zero.
 bool balanced(const std::string& s) {
@@ -68,5 +68,5 @@ TEST(Citations, MalformedEntriesAreRejected) {
   EXPECT_EQ(two[1].key, "b");
 }
 
-}  // namespace
+}  // namespace citations_test
 }  // namespace mpmtb

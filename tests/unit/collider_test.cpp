@@ -8,7 +8,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace collider_test {
 
 std::string sheet(const std::string& wall) {
   return "[scene]\nname = \"sheet\"\ndim = 2\n"
@@ -63,11 +63,11 @@ TEST_P(Collider, MomentumBalancePinningPenetrationAndEnergy) {
 
 INSTANTIATE_TEST_SUITE_P(Walls, Collider, ::testing::Values("sticky", "slip", "separate"));
 
-}  // namespace
+}  // namespace collider_test
 }  // namespace mpmtb
 
 namespace mpmtb {
-namespace {
+namespace collider_test {
 
 // With the damage model, the sheet tears where the ball passes. The ball also
 // drags the sheet against its pinned edge, which may tear there too; damage
@@ -100,5 +100,5 @@ TEST(PinnedSheet, DamageDevelopsAlongTheBallsPath) {
       << "damage must stay local";
 }
 
-}  // namespace
+}  // namespace collider_test
 }  // namespace mpmtb

@@ -12,7 +12,7 @@
 #include "core/errors.hpp"
 
 namespace mpmtb::compare {
-namespace {
+namespace compare_test {
 
 namespace fs = std::filesystem;
 
@@ -209,5 +209,5 @@ TEST(CompareGlob, Wildcards) {
   EXPECT_FALSE(glob_match("series.csv", "bar.csv"));
 }
 
-}  // namespace
+}  // namespace compare_test
 }  // namespace mpmtb::compare

@@ -15,7 +15,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace damage_length_test {
 
 // The 2D pinned sheet struck by a ball (as in collider_test.cpp), damage with l0.
 std::string sheet_toml(Real l0) {
@@ -171,5 +171,5 @@ TEST(DamageLength, DamageZoneWidensWithLengthScale) {
             << w2 << " " << w4 << "\n";
 }
 
-}  // namespace
+}  // namespace damage_length_test
 }  // namespace mpmtb

@@ -22,7 +22,7 @@
 #include "support/random_matrices.hpp"
 
 namespace mpmtb {
-namespace {
+namespace damage_test {
 
 using testing::FiniteDifferenceP;
 using testing::RandomMatrix;
@@ -334,5 +334,5 @@ TEST(DamageParameters, InvalidValuesAreRejectedByName) {
   ExpectRejected(missing, "sigma_crit");
 }
 
-}  // namespace
+}  // namespace damage_test
 }  // namespace mpmtb

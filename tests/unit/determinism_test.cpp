@@ -12,7 +12,7 @@
 #include "support/cli.hpp"
 
 namespace mpmtb {
-namespace {
+namespace determinism_test {
 
 struct Output {
   std::string series;
@@ -108,5 +108,5 @@ INSTANTIATE_TEST_SUITE_P(
         "rotating --transfer polypic --cells 64 --ppc 4 --t-end 0.03"),
     SceneName);
 
-}  // namespace
+}  // namespace determinism_test
 }  // namespace mpmtb

@@ -10,7 +10,7 @@
 #include "support/cli.hpp"
 
 namespace mpmtb {
-namespace {
+namespace failure_test {
 
 using testing::run_cli;
 using testing::scratch_path;
@@ -159,5 +159,5 @@ TEST(TimeStep, CflStepIsAdaptedEachStep) {
   EXPECT_LE(dt_max, 0.5 * 1.5625 / 10 * (1 + 1e-12));
 }
 
-}  // namespace
+}  // namespace failure_test
 }  // namespace mpmtb

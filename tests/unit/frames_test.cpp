@@ -13,7 +13,7 @@
 #include "vtk/vtk_xml.hpp"
 
 namespace mpmtb {
-namespace {
+namespace frames_test {
 
 // sigma_vm = sqrt(3/2 s:s): uniaxial stress s gives |s|, pure shear t gives
 // sqrt(3) |t|, a hydrostatic state gives 0 (e.g. Hill 1950, ch. 2).
@@ -98,5 +98,5 @@ TEST(Progress, DrawsOneLineOnlyWhenEnabled) {
   EXPECT_EQ(Progress::format_line("bar", 0, 0, NAN), "bar   0.0%  0 steps/s  --:-- left");
 }
 
-}  // namespace
+}  // namespace frames_test
 }  // namespace mpmtb

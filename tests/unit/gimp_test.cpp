@@ -26,7 +26,7 @@
 #include "transfers/mls.hpp"
 
 namespace mpmtb {
-namespace {
+namespace gimp_test {
 
 using K = GimpKernel;
 const std::vector<Real> kHalfWidths = {Real(1) / 32, Real(1) / 8, Real(1) / 6, Real(0.25),
@@ -280,5 +280,5 @@ TEST(GimpRuns, LargeAmplitudeManufacturedBarStaysFarBelowTheHat) {
   }
 }
 
-}  // namespace
+}  // namespace gimp_test
 }  // namespace mpmtb

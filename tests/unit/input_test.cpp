@@ -12,7 +12,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace input_test {
 
 using testing::run_cli;
 using testing::scratch_path;
@@ -175,5 +175,5 @@ TEST(BadInput, SweepWritesOnlyInvalidSummaries) {
   std::filesystem::remove_all(out);
 }
 
-}  // namespace
+}  // namespace input_test
 }  // namespace mpmtb

@@ -17,7 +17,7 @@
 #include "kernels/all.hpp"
 
 namespace mpmtb {
-namespace {
+namespace kernel_test {
 
 // AllKernels as a gtest type list, so a newly registered kernel joins these tests.
 template <class L>
@@ -327,5 +327,5 @@ TEST(LinearKernel, GradientsSumToZeroOnNodes) {
   }
 }
 
-}  // namespace
+}  // namespace kernel_test
 }  // namespace mpmtb

@@ -15,7 +15,7 @@
 #include "scene.hpp"
 
 namespace mpmtb {
-namespace {
+namespace manufactured_test {
 
 template <int Dim>
 struct Case {
@@ -176,5 +176,5 @@ TEST(ManufacturedSolution, RejectsOtherModelsAndBadAmplitudes) {
   EXPECT_THROW(make_case<2>("mms_axis", {"bodies.0.max=[0.5,1,1]"}), InputError);
 }
 
-}  // namespace
+}  // namespace manufactured_test
 }  // namespace mpmtb

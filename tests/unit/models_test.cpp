@@ -27,7 +27,7 @@
 #include "support/random_matrices.hpp"
 
 namespace mpmtb {
-namespace {
+namespace models_test {
 
 using testing::FiniteDifferenceP;
 using testing::RandomF;
@@ -332,5 +332,5 @@ TEST(FixedCorotatedModel, DefinedForInvertedAndDegenerateF) {
   EXPECT_LT((P0.array() * cofactor<3>(flat).array()).sum(), 0);
 }
 
-}  // namespace
+}  // namespace models_test
 }  // namespace mpmtb

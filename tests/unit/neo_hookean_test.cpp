@@ -19,7 +19,7 @@
 #include "support/random_matrices.hpp"
 
 namespace mpmtb {
-namespace {
+namespace neo_hookean_test {
 
 using testing::FiniteDifferenceP;
 using testing::RandomF;
@@ -189,5 +189,5 @@ TEST(NeoHookeanParameters, UnknownKeyIsRejected) {
   }
 }
 
-}  // namespace
+}  // namespace neo_hookean_test
 }  // namespace mpmtb

@@ -16,7 +16,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace nonlocal_test {
 
 // A box of damage material [0.2, 0.8]^dim on a grid of `cells`, 2 ppc.
 std::string block_toml(int dim, int cells, const std::string& kernel) {
@@ -160,5 +160,5 @@ TEST(NonlocalLaplacian, ReusedAfterTheBodyMovesEqualsAFreshOperator) {
   }
 }
 
-}  // namespace
+}  // namespace nonlocal_test
 }  // namespace mpmtb

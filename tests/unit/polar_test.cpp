@@ -18,7 +18,7 @@
 #include "support/random_matrices.hpp"
 
 namespace mpmtb {
-namespace {
+namespace polar_test {
 
 using testing::RandomMatrix;
 using testing::RandomRotation;
@@ -180,5 +180,5 @@ TEST(Polar1D, SignGoesIntoTheSingularValue) {
   }
 }
 
-}  // namespace
+}  // namespace polar_test
 }  // namespace mpmtb

@@ -17,7 +17,7 @@
 #include "transfers/polypic.hpp"
 
 namespace mpmtb {
-namespace {
+namespace polypic_test {
 
 // The 1D modes of a stencil: e_0 = 1, e_1 = u (B-splines have zero first
 // moment), orthogonal under the weights; the norms are the weighted sums.
@@ -165,5 +165,5 @@ TEST(Polypic, KeepsAtLeastApicsEnergyOnTheDisks) {
   RecordProperty("polypic", std::to_string(polypic));
 }
 
-}  // namespace
+}  // namespace polypic_test
 }  // namespace mpmtb

@@ -17,7 +17,7 @@
 #include "support/combinations.hpp"
 
 namespace mpmtb {
-namespace {
+namespace registry_test {
 
 // Standard output of `mpmtb ARGS`.
 std::string cli_stdout(const std::string& args) {
@@ -127,5 +127,5 @@ TEST(Registry, EveryModelJoinsTheModelTests) {
   }
 }
 
-}  // namespace
+}  // namespace registry_test
 }  // namespace mpmtb

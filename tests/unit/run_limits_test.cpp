@@ -18,7 +18,7 @@
 #include "support/cli.hpp"
 
 namespace mpmtb {
-namespace {
+namespace run_limits_test {
 
 using testing::run_cli;
 using testing::scratch_path;
@@ -157,5 +157,5 @@ TEST(RunChecks, ResumeWithoutACheckpointIsRefused) {
   std::filesystem::remove_all(dir);
 }
 
-}  // namespace
+}  // namespace run_limits_test
 }  // namespace mpmtb

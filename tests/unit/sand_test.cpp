@@ -21,7 +21,7 @@
 #include "support/random_matrices.hpp"
 
 namespace mpmtb {
-namespace {
+namespace sand_test {
 
 using testing::RandomRotation;
 
@@ -246,5 +246,5 @@ TYPED_TEST(SandTest, HardeningOpensTheCone) {
   EXPECT_NEAR(m.friction_angle(q.data()), 35, 1e-9);
 }
 
-}  // namespace
+}  // namespace sand_test
 }  // namespace mpmtb

@@ -15,7 +15,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace scene_fuzz_test {
 
 const std::vector<std::string> kTokens = {"[",
                                           "]",
@@ -280,5 +280,5 @@ TEST(SceneFuzz, EveryInputIsAcceptedOrRejectedWithAMessage) {
   EXPECT_GT(rejected, inputs / 5);
 }
 
-}  // namespace
+}  // namespace scene_fuzz_test
 }  // namespace mpmtb

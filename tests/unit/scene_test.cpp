@@ -10,7 +10,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace scene_test {
 
 // Expects read_scene to throw an InputError whose message contains every `part`.
 void expect_rejected(const std::string& toml, std::initializer_list<std::string> parts,
@@ -139,5 +139,5 @@ TEST(Cli, MalformedSceneFileNamesTheFileAndLine) {
   EXPECT_NE(c.err.find("mpmtb_bad_scene.toml:3"), std::string::npos) << c.err;
 }
 
-}  // namespace
+}  // namespace scene_test
 }  // namespace mpmtb

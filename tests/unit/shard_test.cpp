@@ -15,7 +15,7 @@
 #include "suite/shard.hpp"
 
 namespace mpmtb::suite {
-namespace {
+namespace shard_test {
 
 std::vector<ShardItem> random_items(int n, unsigned seed) {
   std::mt19937 rng(seed);
@@ -173,5 +173,5 @@ TEST(Shards, TheConvergenceSuiteSplitsIntoDisjointBalancedShards) {
   EXPECT_NEAR(l1 / l0, 4.0, 0.5);
 }
 
-}  // namespace
+}  // namespace shard_test
 }  // namespace mpmtb::suite

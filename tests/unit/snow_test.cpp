@@ -19,7 +19,7 @@
 #include "support/random_matrices.hpp"
 
 namespace mpmtb {
-namespace {
+namespace snow_test {
 
 using testing::RandomMatrix;
 
@@ -209,11 +209,11 @@ TEST(SnowModel, ClampCanRaiseStoredEnergyAndTheBudgetStillCloses) {
   check(snow3, Mat<3>(Vec<3>(1.0175, 0.976, 0.976).asDiagonal()));
 }
 
-}  // namespace
+}  // namespace snow_test
 }  // namespace mpmtb
 
 namespace mpmtb {
-namespace {
+namespace snow_test {
 
 // The reported volume ratio is the total J = J_E J_P, not the elastic part.
 TEST(SnowVolume, TotalJIncludesThePlasticPart) {
@@ -235,5 +235,5 @@ TEST(SnowVolume, TotalJIncludesThePlasticPart) {
   EXPECT_NEAR(m->total_J(P.F[0], P.state_of(0)), J_trial, 1e-12);
 }
 
-}  // namespace
+}  // namespace snow_test
 }  // namespace mpmtb

@@ -10,7 +10,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace step_test {
 
 using testing::Combination;
 
@@ -158,5 +158,5 @@ TEST(AffineTransfer, FreeFlightConservesAngularMomentum) {
   }
 }
 
-}  // namespace
+}  // namespace step_test
 }  // namespace mpmtb

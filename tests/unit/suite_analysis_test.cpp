@@ -8,7 +8,7 @@
 #include "suite/analysis.hpp"
 
 namespace mpmtb::suite {
-namespace {
+namespace suite_analysis_test {
 
 std::vector<double> halving(double h0, int n) {
   std::vector<double> h;
@@ -95,5 +95,5 @@ TEST(SuiteStability, LargestStableStopsAtTheFirstFailure) {
   EXPECT_TRUE(std::isnan(r.stable));
 }
 
-}  // namespace
+}  // namespace suite_analysis_test
 }  // namespace mpmtb::suite

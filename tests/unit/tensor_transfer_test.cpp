@@ -16,7 +16,7 @@
 #include "transfers/all.hpp"
 
 namespace mpmtb {
-namespace {
+namespace tensor_transfer_test {
 
 template <int Dim>
 Mat<Dim> random_matrix(std::mt19937& rng) {
@@ -151,5 +151,5 @@ TEST(TensorTransfer, KernelWeightsMatchNAndDN) {
   });
 }
 
-}  // namespace
+}  // namespace tensor_transfer_test
 }  // namespace mpmtb

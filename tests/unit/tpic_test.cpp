@@ -8,7 +8,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace tpic_test {
 
 template <int Dim>
 struct SpinRun {
@@ -65,5 +65,5 @@ TEST(Tpic, AngularMomentumDriftIsRealButFarBelowPics) {
   }
 }
 
-}  // namespace
+}  // namespace tpic_test
 }  // namespace mpmtb

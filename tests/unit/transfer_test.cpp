@@ -12,7 +12,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace transfer_test {
 
 using testing::Combination;
 
@@ -191,5 +191,5 @@ TEST(TransferParameters, FlipAlphaOutOfRangeIsRejected) {
   }
 }
 
-}  // namespace
+}  // namespace transfer_test
 }  // namespace mpmtb

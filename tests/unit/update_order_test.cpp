@@ -15,7 +15,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace update_order_test {
 
 using testing::Combination;
 
@@ -193,5 +193,5 @@ TEST(UpdateOrder, RecordedInTheSummaryConfig) {
   std::filesystem::remove_all(out);
 }
 
-}  // namespace
+}  // namespace update_order_test
 }  // namespace mpmtb

@@ -9,7 +9,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace walls_test {
 
 template <int Dim, class Kernel>
 Vec<Dim> interpolate(const Grid<Dim>& g, const Vec<Dim>& x) {
@@ -89,11 +89,11 @@ TEST(Walls, SeparateHoldsOnlyInward) {
   }
 }
 
-}  // namespace
+}  // namespace walls_test
 }  // namespace mpmtb
 
 namespace mpmtb {
-namespace {
+namespace walls_test {
 
 // Pinned particles hold every node they touch at rest, so they do not move at
 // all, while the rest of the body sags under gravity.
@@ -124,5 +124,5 @@ TEST(Pins, PinnedParticlesStayPutUnderGravity) {
   }
 }
 
-}  // namespace
+}  // namespace walls_test
 }  // namespace mpmtb

@@ -18,7 +18,7 @@
 #include "support/scenes.hpp"
 
 namespace mpmtb {
-namespace {
+namespace xpic_test {
 
 struct Outcome {
   std::vector<Vec<2>> x, v;
@@ -93,5 +93,5 @@ TEST(Xpic, OrderOutOfRangeIsRejected) {
   }
 }
 
-}  // namespace
+}  // namespace xpic_test
 }  // namespace mpmtb

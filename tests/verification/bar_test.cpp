@@ -17,7 +17,7 @@
 #include "run.hpp"
 
 namespace mpmtb {
-namespace {
+namespace bar_test {
 
 nlohmann::json run_bar(const Overrides& o) {
   const Scene scene = load_scene("bar", o);
@@ -74,5 +74,5 @@ TEST_P(Bar, OneTwoAndThreeDimensionsAgree) {
 
 INSTANTIATE_TEST_SUITE_P(BSplines, Bar, ::testing::Values("quadratic", "cubic"));
 
-}  // namespace
+}  // namespace bar_test
 }  // namespace mpmtb

@@ -17,7 +17,7 @@
 #include "run.hpp"
 
 namespace mpmtb {
-namespace {
+namespace column_test {
 
 constexpr double kW0 = 0.125;  // the scene's column width
 
@@ -67,5 +67,5 @@ TEST(ColumnCollapse, RunoutFallsWithFrictionAngle) {
   EXPECT_LT(runout[2], 0.25 * runout[1]) << "a very frictional column barely spreads";
 }
 
-}  // namespace
+}  // namespace column_test
 }  // namespace mpmtb

@@ -11,7 +11,7 @@
 #include "support/csv.hpp"
 
 namespace mpmtb {
-namespace {
+namespace disks_test {
 
 // Total energy at the end over total energy at the start.
 Real energy_kept(const std::string& transfer, int cells) {
@@ -32,5 +32,5 @@ TEST(Disks, EnergyKeptFollowsThePublishedOrdering) {
   EXPECT_GT(energy_kept("apic", 40), apic) << "APIC approaches FLIP under refinement";
 }
 
-}  // namespace
+}  // namespace disks_test
 }  // namespace mpmtb

@@ -24,7 +24,7 @@
 #include "run.hpp"
 
 namespace mpmtb {
-namespace {
+namespace energy_budget_test {
 
 struct Budget {
   Real drift;       // summary drift.energy: (total(t_end) - total(0)) / max(K + S)
@@ -83,5 +83,5 @@ INSTANTIATE_TEST_SUITE_P(Models, EnergyBudget,
                            return n;
                          });
 
-}  // namespace
+}  // namespace energy_budget_test
 }  // namespace mpmtb

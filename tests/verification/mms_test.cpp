@@ -25,7 +25,7 @@
 #include "support/convergence.hpp"
 
 namespace mpmtb {
-namespace {
+namespace mms_test {
 
 using testing::error_table;
 using testing::errors_over;
@@ -131,5 +131,5 @@ INSTANTIATE_TEST_SUITE_P(BSplines, AxisAligned2D,
                                             ::testing::Values("quadratic", "cubic")),
                          combination_name);
 
-}  // namespace
+}  // namespace mms_test
 }  // namespace mpmtb

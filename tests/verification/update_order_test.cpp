@@ -51,7 +51,7 @@
 #include "setup.hpp"
 
 namespace mpmtb {
-namespace {
+namespace update_order_test {
 
 constexpr Real kPi = std::numbers::pi_v<Real>;
 constexpr Real kOmega2 = 4 * kPi * kPi;  // E V / (m L^2) with E = 4 pi^2, rho = 1, L = 1
@@ -229,5 +229,5 @@ TEST_P(BarOrder, MuslKeepsTheVcmBands) {
 
 INSTANTIATE_TEST_SUITE_P(Kernels, BarOrder, ::testing::Values("linear", "quadratic"));
 
-}  // namespace
+}  // namespace update_order_test
 }  // namespace mpmtb
