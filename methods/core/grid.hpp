@@ -19,6 +19,7 @@ struct GridGeometry {
 
   Vec<Dim> lo = Vec<Dim>::Zero();
   Real dx = 1;
+  Real inv_dx = 1;  // 1 / dx, divided once (every stencil scales by it)
   std::array<int, Dim> cells{};
   // Particle half-width in cell units, l = 1/(2 ppc), for kernels that average over
   // the particle domain (uGIMP, kernels/gimp.hpp); set from the scene's ppc. The
@@ -27,7 +28,7 @@ struct GridGeometry {
 
   GridGeometry() = default;
   GridGeometry(const Vec<Dim>& lower, Real spacing, const std::array<int, Dim>& n)
-      : lo(lower), dx(spacing), cells(n) {
+      : lo(lower), dx(spacing), inv_dx(1 / spacing), cells(n) {
     long stride = 1;
     for (int a = Dim - 1; a >= 0; --a) {
       strides_[a] = stride;

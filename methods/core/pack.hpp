@@ -25,6 +25,8 @@
 
 // The transfers' per-node code is inlined whole.
 #define MPMTB_INLINE [[gnu::always_inline]]
+// The same for a lambda (after its parameter list).
+#define MPMTB_INLINE_LAMBDA __attribute__((always_inline))
 
 namespace mpmtb {
 
@@ -50,6 +52,30 @@ template <>
 struct PackOf<64> {
   typedef Real type __attribute__((vector_size(64)));
 };
+
+// x y + z per lane, rounded once. The fusion is spelled here, not left to the
+// compiler (-ffp-contract=off): every target computes the same bits, with the
+// FMA instruction where it has one and std::fma (correctly rounded, so equal)
+// where it has not.
+template <class Pack>
+MPMTB_INLINE inline Pack fused(Pack x, Pack y, Pack z) {
+  constexpr int bytes = sizeof(Pack);
+  constexpr bool is_double = std::is_same_v<Real, double>;
+#if defined(__AVX512F__)
+  if constexpr (bytes == 64 && is_double) return _mm512_fmadd_pd(x, y, z);
+  if constexpr (bytes == 64 && !is_double) return _mm512_fmadd_ps(x, y, z);
+#endif
+#if defined(__FMA__)
+  if constexpr (bytes == 32 && is_double) return _mm256_fmadd_pd(x, y, z);
+  if constexpr (bytes == 32 && !is_double) return _mm256_fmadd_ps(x, y, z);
+  if constexpr (bytes == 16 && is_double) return _mm_fmadd_pd(x, y, z);
+  if constexpr (bytes == 16 && !is_double) return _mm_fmadd_ps(x, y, z);
+#endif
+  Pack r;
+  for (int i = 0; i < bytes / static_cast<int>(sizeof(Real)); ++i)
+    r[i] = std::fma(x[i], y[i], z[i]);
+  return r;
+}
 
 // N reals (N * sizeof(Real) a multiple of 16 bytes) as K registers.
 template <int N>
@@ -81,7 +107,7 @@ struct Row {
   MPMTB_INLINE static Row gather(const Real* from) {
     Row r;
     for (int k = 0; k < K; ++k) {
-      r.v[k] = [&]<int... i>(std::integer_sequence<int, i...>) {
+      r.v[k] = [&]<int... i>(std::integer_sequence<int, i...>) MPMTB_INLINE_LAMBDA {
         return Pack{from[k * lanes + i]...};
       }
       (std::make_integer_sequence<int, lanes>{});
@@ -97,34 +123,115 @@ struct Row {
     for (int k = 0; k < K; ++k) v[k] += a.v[k];
     return *this;
   }
-  // *this += s a, each lane as one fused multiply-add (rounded once). The
-  // fusion is spelled here, not left to the compiler (-ffp-contract=off): every
-  // target computes the same bits, with the FMA instruction where it has one
-  // and std::fma (correctly rounded, so equal) where it has not, and every
-  // transfer that sums through a Row rounds the same way.
+  // *this += s a, each lane as one fused multiply-add (rounded once, fused()),
+  // so that every transfer that sums through a Row rounds the same way.
   MPMTB_INLINE void add_scaled(Real s, const Row& a) {
     const Pack sp = s - Pack{};  // s in every lane
     for (int k = 0; k < K; ++k) v[k] = fused(sp, a.v[k], v[k]);
   }
+};
 
- private:
-  // x y + z per lane, rounded once.
-  MPMTB_INLINE static Pack fused(Pack x, Pack y, Pack z) {
-    constexpr bool is_double = std::is_same_v<Real, double>;
-#if defined(__AVX512F__)
-    if constexpr (bytes == 64 && is_double) return _mm512_fmadd_pd(x, y, z);
-    if constexpr (bytes == 64 && !is_double) return _mm512_fmadd_ps(x, y, z);
-#endif
-#if defined(__FMA__)
-    if constexpr (bytes == 32 && is_double) return _mm256_fmadd_pd(x, y, z);
-    if constexpr (bytes == 32 && !is_double) return _mm256_fmadd_ps(x, y, z);
-    if constexpr (bytes == 16 && is_double) return _mm_fmadd_pd(x, y, z);
-    if constexpr (bytes == 16 && !is_double) return _mm_fmadd_ps(x, y, z);
-#endif
-    Pack r;
-    for (int i = 0; i < lanes; ++i) r[i] = std::fma(x[i], y[i], z[i]);
+// A stencil row: the N = S * W values of the S nodes along the grid's fastest
+// axis (W per node, consecutive in memory), as the fewest registers: the widest
+// packs first, then narrower ones (12 doubles: 8 + 4 with AVX-512, 4 + 4 + 4 with
+// AVX2). The transfers' last axis works on whole strips, so a row of nodes costs
+// one load, one add and one store per register instead of per node.
+template <int N>
+struct Strip {
+  static constexpr int count = N;
+  static constexpr int bytes = [] {
+    int b = kSimdBytes;
+    while (b > 16 && b > N * static_cast<int>(sizeof(Real))) b /= 2;
+    return b;
+  }();
+  static constexpr int lanes = bytes / sizeof(Real);
+  static_assert(N * sizeof(Real) % 16 == 0, "a Strip is whole 16-byte registers");
+  using Pack = typename PackOf<bytes>::type;
+  Pack head;
+  Strip<N - lanes> tail;
+
+  // Lane l = f(l), built in registers.
+  template <int First = 0, class F>
+  MPMTB_INLINE static Strip from(F&& f) {
+    Strip s;
+    s.head = [&]<int... i>(std::integer_sequence<int, i...>) MPMTB_INLINE_LAMBDA {
+      return Pack{f(First + i)...};
+    }
+    (std::make_integer_sequence<int, lanes>{});
+    s.tail = Strip<N - lanes>::template from<First + lanes>(f);
+    return s;
+  }
+  // The W values of a Row repeated across the strip's S nodes (lane l = r[l % W]).
+  template <int W>
+  MPMTB_INLINE static Strip repeat(const Row<W>& r) {
+    return from([&](int l) MPMTB_INLINE_LAMBDA {
+      return r.v[(l % W) / Row<W>::lanes][(l % W) % Row<W>::lanes];
+    });
+  }
+  MPMTB_INLINE static Strip load(const Real* from) {
+    Strip s;
+    std::memcpy(&s.head, from, bytes);
+    s.tail = Strip<N - lanes>::load(from + lanes);
+    return s;
+  }
+  MPMTB_INLINE void store(Real* to) const {
+    std::memcpy(to, &head, bytes);
+    tail.store(to + lanes);
+  }
+  // Per lane: a b, a + b, and a b + c rounded once (fused()).
+  MPMTB_INLINE friend Strip operator*(const Strip& a, const Strip& b) {
+    Strip s;
+    s.head = a.head * b.head;
+    s.tail = a.tail * b.tail;
+    return s;
+  }
+  MPMTB_INLINE friend Strip operator+(const Strip& a, const Strip& b) {
+    Strip s;
+    s.head = a.head + b.head;
+    s.tail = a.tail + b.tail;
+    return s;
+  }
+  MPMTB_INLINE static Strip fma(const Strip& a, const Strip& b, const Strip& c) {
+    Strip s;
+    s.head = fused(a.head, b.head, c.head);
+    s.tail = Strip<N - lanes>::fma(a.tail, b.tail, c.tail);
+    return s;
+  }
+  // a b + c with a scalar a in every lane.
+  MPMTB_INLINE static Strip fma(Real a, const Strip& b, const Strip& c) {
+    Strip s;
+    s.head = fused(a - Pack{}, b.head, c.head);
+    s.tail = Strip<N - lanes>::fma(a, b.tail, c.tail);
+    return s;
+  }
+  // Lane l of the strip.
+  MPMTB_INLINE Real operator[](int l) const { return l < lanes ? head[l] : tail[l - lanes]; }
+  // Lanes First .. First + W - 1 as a Row, in registers.
+  template <int First, int W>
+  MPMTB_INLINE Row<W> segment() const {
+    Row<W> r;
+    for (int k = 0; k < Row<W>::K; ++k) {
+      r.v[k] = [&]<int... i>(std::integer_sequence<int, i...>) MPMTB_INLINE_LAMBDA {
+        return typename Row<W>::Pack{(*this)[First + k * Row<W>::lanes + i]...};
+      }
+      (std::make_integer_sequence<int, Row<W>::lanes>{});
+    }
     return r;
   }
+};
+template <>
+struct Strip<0> {
+  template <int First, class F>
+  MPMTB_INLINE static Strip from(F&&) {
+    return {};
+  }
+  MPMTB_INLINE static Strip load(const Real*) { return {}; }
+  MPMTB_INLINE void store(Real*) const {}
+  MPMTB_INLINE friend Strip operator*(const Strip&, const Strip&) { return {}; }
+  MPMTB_INLINE friend Strip operator+(const Strip&, const Strip&) { return {}; }
+  MPMTB_INLINE static Strip fma(const Strip&, const Strip&, const Strip&) { return {}; }
+  MPMTB_INLINE static Strip fma(Real, const Strip&, const Strip&) { return {}; }
+  MPMTB_INLINE Real operator[](int) const { return 0; }
 };
 
 // A Row built lane by lane, with the Eigen-like setters the transfers write

@@ -28,7 +28,7 @@ class ParticleBlocks {
   void bin(const std::vector<Vec<Dim>>& x, const GridGeometry<Dim>& geo, NodeBox<Dim>& box) {
     constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
     const long n = static_cast<long>(x.size());
-    const Real inv_dx = 1 / geo.dx;
+    const Real inv_dx = geo.inv_dx;
     int lo[Dim], hi[Dim];
     std::fill_n(lo, Dim, std::numeric_limits<int>::max());
     std::fill_n(hi, Dim, std::numeric_limits<int>::min());

@@ -49,8 +49,10 @@ typename Policy::Gather begin_gather(const Policy& policy, const Stencil<Dim, Ke
 // G2P on the fast path: the policy's Gather from the packed velocity rows
 // (VelocityRows) around the particle.
 template <class Policy, int Dim, class Kernel>
-typename Policy::Gather tensor_gather(const Policy& policy, const Stencil<Dim, Kernel>& st,
-                                      const GridGeometry<Dim>& g, const Real* rows) {
+MPMTB_INLINE inline typename Policy::Gather tensor_gather(const Policy& policy,
+                                                          const Stencil<Dim, Kernel>& st,
+                                                          const GridGeometry<Dim>& g,
+                                                          const Real* rows) {
   constexpr TensorTerms terms = Policy::gather_terms;
   using Sums = TensorTransfer<Dim, Kernel>;
   if constexpr (terms.nodal) {

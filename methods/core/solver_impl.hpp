@@ -145,12 +145,13 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     P.use_transfer_state(kTransferState);
     if constexpr (kTensorPath) pack_velocities(rows_, g, g.v.data(), g.v_old.data());
     const long n = static_cast<long>(P.size());
-    Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min, v_max = 0;
+    Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min, v2_max = 0;
     long non_finite = n, outside = n;
+    const Vec<Dim> lo = g.geo.lo, hi = g.geo.hi();  // the closed box of GridGeometry::contains
 #pragma omp parallel for schedule(static) reduction(min                           \
                                                     : J_min, non_finite, outside) \
     reduction(max                                                                 \
-              : J_max, v_max) if (n >= kParallelMinimum)
+              : J_max, v2_max) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       const StencilT st(P.x[p], g.geo);
       typename Policy::Gather gather;
@@ -169,19 +170,23 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
         policy.finish(gather, P, static_cast<int>(p), dt);
         P.F[p] = F;
       }
-      // Failure detection, fused into this loop so that it costs nothing extra.
+      // Failure detection, fused into this loop so that it costs nothing extra:
+      // the squared speed (one square root per step, below), and the box test
+      // first, which only a non-finite or escaped position fails.
       const Real J = P.F[p].determinant();
       J_min = std::min(J_min, J);
       J_max = std::max(J_max, J);
-      const Real speed = P.v[p].norm();
-      v_max = std::max(v_max, speed);
-      if (!std::isfinite(J) || !std::isfinite(speed) || !P.x[p].allFinite()) {
+      const Real v2 = P.v[p].squaredNorm();
+      v2_max = std::max(v2_max, v2);
+      const bool inside = ((P.x[p].array() >= lo.array()) && (P.x[p].array() <= hi.array())).all();
+      if (!std::isfinite(J) || !std::isfinite(v2) || (!inside && !P.x[p].allFinite())) {
         non_finite = std::min(non_finite, p);
-      } else if (!g.geo.contains(P.x[p])) {
+      } else if (!inside) {
         outside = std::min(outside, p);
       }
     }
-    return {J_min, J_max, v_max, non_finite == n ? -1 : non_finite, outside == n ? -1 : outside};
+    return {J_min, J_max, std::sqrt(v2_max), non_finite == n ? -1 : non_finite,
+            outside == n ? -1 : outside};
   }
 
   Vec3 affine_angular_momentum(const State<Dim>& s) const override {

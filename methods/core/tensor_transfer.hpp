@@ -157,8 +157,8 @@ class TensorTransfer {
  public:
   // Adds the form to the stencil's nodes of `sums` (NodeSums: N values per node).
   template <TensorTerms T>
-  static void scatter(const St& st, const GridGeometry<Dim>& g, const ScatterForm<Dim>& form,
-                      Real* __restrict sums) {
+  MPMTB_INLINE static void scatter(const St& st, const GridGeometry<Dim>& g,
+                                   const ScatterForm<Dim>& form, Real* __restrict sums) {
     P gamma[Dim], beta[Dim];
     for (int a = 0; a < Dim; ++a) {
       if constexpr (T.moment) gamma[a] = form.gamma[a].row();
@@ -169,8 +169,9 @@ class TensorTransfer {
   // The same into folded sums (NodeSums<Dim, true>): each column of the form
   // becomes (m, p + dt f) before the stencil loop, so every node adds half a row.
   template <TensorTerms T>
-  static void scatter_folded(const St& st, const GridGeometry<Dim>& g, const ScatterForm<Dim>& form,
-                             Real dt, Real* __restrict sums) {
+  MPMTB_INLINE static void scatter_folded(const St& st, const GridGeometry<Dim>& g,
+                                          const ScatterForm<Dim>& form, Real dt,
+                                          Real* __restrict sums) {
     using PF = Row<kFoldedWidth<Dim>>;
     PF gamma[Dim], beta[Dim];
     for (int a = 0; a < Dim; ++a) {
@@ -183,13 +184,17 @@ class TensorTransfer {
   // The sums from the packed velocities (VelocityRows<Dim, T.old>::data()); with
   // T.nodal also nodal[j] = w_ip v_i for the stencil's nodes j (St::count values).
   template <TensorTerms T>
-  static GatherSums<Dim> gather(const St& st, const GridGeometry<Dim>& g,
-                                const Real* __restrict rows, Vec<Dim>* nodal = nullptr) {
-    Real wd[Dim][S];
-    for (int a = 0; a < Dim; ++a)
-      for (int k = 0; k < S; ++k) wd[a][k] = st.w[a][k] * st.d[a][k];
+  MPMTB_INLINE static GatherSums<Dim> gather(const St& st, const GridGeometry<Dim>& g,
+                                             const Real* __restrict rows,
+                                             Vec<Dim>* nodal = nullptr) {
+    AxisPack wd[S];  // w_a d_a of node k, axis a in lane a (as Stencil's factors)
+    for (int k = 0; k < S; ++k) wd[k] = st.wk[k] * st.dk[k];
     Partial<T> part;
-    gather_axis<0, T>(st, wd, g.strides(), st.base_node, rows, nodal, 0, Real(1), part);
+    if constexpr (T.nodal) {
+      gather_axis<0, T>(st, wd, g.strides(), st.base_node, rows, nodal, 0, Real(1), part);
+    } else {
+      gather_strips<T>(st, wd, g.strides(), rows, part);
+    }
     GatherSums<Dim> out;
     Real sum[VR<T>::N];
     part.W.store(sum);
@@ -219,12 +224,27 @@ class TensorTransfer {
 
   using P = Row<N>;
 
-  // (m, p + dt f) of a form column, in registers.
+  // (m, p + dt f) of a form column: whole registers, (m, p, 0) + dt (0, f, 0),
+  // both shuffled from the column's lanes (in registers: lanes written one by
+  // one and read back as a register would stall on store forwarding).
   MPMTB_INLINE static Row<kFoldedWidth<Dim>> fold(const typename Form::Col& c, Real dt) {
-    RowBuilder<kFoldedWidth<Dim>> r;
-    r[Form::m] = c[Form::m];
-    for (int a = 0; a < Dim; ++a) r[Form::p + a] = c[Form::p + a] + dt * c[Form::f + a];
-    return r.row();
+    using FR = Row<kFoldedWidth<Dim>>;
+    const Row<N>& col = c.row();
+    const auto lane = [&](int i) MPMTB_INLINE_LAMBDA -> Real {
+      return col.v[i / Row<N>::lanes][i % Row<N>::lanes];
+    };
+    static_assert(FR::K == 1, "a folded row is one register");
+    FR mp, f;
+    [&]<int... i>(std::integer_sequence<int, i...>) MPMTB_INLINE_LAMBDA {
+      constexpr auto in_p = [](int l) { return l >= Form::p && l < Form::p + Dim; };
+      mp.v[0] = typename FR::Pack{(i <= Dim ? lane(i) : Real(0))...};
+      f.v[0] =
+          typename FR::Pack{(in_p(i) ? lane(in_p(i) ? Form::f + i - Form::p : 0) : Real(0))...};
+    }
+    (std::make_integer_sequence<int, FR::lanes>{});
+    FR r = dt * f;  // lane by lane c_p + dt c_f, as (m, p + dt f) was always formed
+    r.v[0] = mp.v[0] + r.v[0];
+    return r;
   }
 
   // The scatter over rows of W values per node: alpha, gamma, beta as rows,
@@ -233,9 +253,8 @@ class TensorTransfer {
   MPMTB_INLINE static void scatter_rows(const St& st, const GridGeometry<Dim>& g, const R& alpha,
                                         const R (&gamma)[Dim], const R (&beta)[Dim],
                                         const Vec<Dim>* nodal_values, Real* __restrict sums) {
-    Real wd[Dim][S];
-    for (int a = 0; a < Dim; ++a)
-      for (int k = 0; k < S; ++k) wd[a][k] = st.w[a][k] * st.d[a][k];
+    AxisPack wd[S];  // w_a d_a of node k, axis a in lane a (as Stencil's factors)
+    for (int k = 0; k < S; ++k) wd[k] = st.wk[k] * st.dk[k];
     R nodal[T.nodal ? St::count : 1];
     if constexpr (T.nodal) {
       for (int j = 0; j < St::count; ++j) {
@@ -244,27 +263,54 @@ class TensorTransfer {
         nodal[j] = row.row();
       }
     }
-    scatter_axis<0, T>(st, wd, g.strides(), st.base_node, alpha, gamma, beta, nodal, 0, Real(1),
-                       sums);
+    const LastAxis<R::count> last(st, wd);
+    scatter_axis<0, T>(st, wd, last, g.strides(), st.base_node, alpha, gamma, beta, nodal, 0,
+                       Real(1), sums);
   }
+
+  // The last axis's factors w_k, w_k d_k and dw_k of node k repeated over its W
+  // values: lane l of a stencil row (Strip) belongs to node l / W.
+  template <int W>
+  struct LastAxis {
+    using L = Strip<S * W>;
+    L w, wd, dw;
+    MPMTB_INLINE LastAxis(const St& st, const AxisPack (&wd_k)[S])
+        : w(L::from([&](int l) MPMTB_INLINE_LAMBDA { return st.w(Dim - 1, l / W); })),
+          wd(L::from([&](int l) MPMTB_INLINE_LAMBDA { return wd_k[l / W][Dim - 1]; })),
+          dw(L::from([&](int l) MPMTB_INLINE_LAMBDA { return st.dw(Dim - 1, l / W); })) {}
+  };
 
   // Top down: on entry to axis A, the node value is
   //   alpha prod_{b>=A} w_b + sum_{a>=A} gamma[a] (prod_{b>=A} w_b) d_a
   //                         + sum_{a>=A} beta[a] dw_a prod_{b>=A, b!=a} w_b;
   // j is the stencil index of the axes before A, w_before = prod_{b<A} w_b.
   template <int A, TensorTerms T, class R, int K>
-  MPMTB_INLINE static inline void scatter_axis(const St& st, const Real (&wd)[Dim][S],
+  MPMTB_INLINE static inline void scatter_axis(const St& st, const AxisPack (&wd)[S],
+                                               const LastAxis<R::count>& last,
                                                const std::array<long, Dim>& stride, long node,
                                                const R& alpha, const R (&gamma)[Dim],
                                                const R (&beta)[Dim], const R (&nodal)[K], int j,
                                                Real w_before, Real* __restrict sums) {
     constexpr int W = R::count;  // values per node
+    if constexpr (A == Dim - 1 && !T.nodal) {
+      // The whole row of S nodes at once, lane by lane the same operations as
+      // node by node below (so the same bits): w alpha + w d gamma + dw beta.
+      using L = Strip<S * W>;
+      L al = last.w * L::repeat(alpha);
+      if constexpr (T.moment) al = L::fma(last.wd, L::repeat(gamma[A]), al);
+      if constexpr (T.gradient) al = L::fma(last.dw, L::repeat(beta[A]), al);
+      Real* out = sums + node * W;
+      (L::load(out) + al).store(out);
+      return;
+    }
     for (int k = 0; k < S; ++k) {
-      const Real w = st.w[A][k];
+      const Real w = st.w(A, k);
       R al = w * alpha;
-      if constexpr (T.moment) al.add_scaled(wd[A][k], gamma[A]);
-      if constexpr (T.gradient) al.add_scaled(st.dw[A][k], beta[A]);
-      const long n = node + k * stride[A];
+      if constexpr (T.moment) al.add_scaled(wd[k][A], gamma[A]);
+      if constexpr (T.gradient) al.add_scaled(st.dw(A, k), beta[A]);
+      // The last axis is the grid's fastest (stride 1, GridGeometry): constant
+      // offsets from the row's first node, no address arithmetic per node.
+      const long n = node + k * (A == Dim - 1 ? 1 : stride[A]);
       if constexpr (A == Dim - 1) {
         if constexpr (T.nodal) al.add_scaled(w_before * w, nodal[j * S + k]);
         Real* out = sums + n * W;
@@ -277,7 +323,8 @@ class TensorTransfer {
           if constexpr (T.moment) g2[a] = w * gamma[a];
           if constexpr (T.gradient) b2[a] = w * beta[a];
         }
-        scatter_axis<A + 1, T>(st, wd, stride, n, al, g2, b2, nodal, j * S + k, w_before * w, sums);
+        scatter_axis<A + 1, T>(st, wd, last, stride, n, al, g2, b2, nodal, j * S + k, w_before * w,
+                               sums);
       }
     }
   }
@@ -292,8 +339,93 @@ class TensorTransfer {
     GR W;
     GR Dm[Dim], Gr[Dim];
   };
+  // The gather by stencil rows (Strip): first the sums over the leading axes of
+  // whole rows, each row weighted by the product of the leading axes' factors
+  // (w_a, or w_a d_a / dw_a for the moment / gradient along axis a), then each
+  // sum reduced along the last axis with its factors. The same sums as node by
+  // node, added in another order; a row costs a load and one fused multiply-add
+  // per sum and register.
+  template <TensorTerms T>
+  struct RowSums {
+    using L = Strip<S * VR<T>::N>;
+    L W;        // sum_q P(q) R_q
+    L Dm[Dim];  // sum_q P(q) with w_a -> w_a d_a, a < Dim - 1
+    L Gr[Dim];  // the same with w_a -> dw_a
+  };
+  template <TensorTerms T>
+  MPMTB_INLINE static void gather_strips(const St& st, const AxisPack (&wd)[S],
+                                         const std::array<long, Dim>& stride,
+                                         const Real* __restrict rows, Partial<T>& out) {
+    using GR = typename Partial<T>::GR;
+    using L = typename RowSums<T>::L;
+    constexpr int B = Dim - 1;  // the last axis
+    RowSums<T> acc;
+    acc.W = L::from([](int) MPMTB_INLINE_LAMBDA { return Real(0); });
+    for (int a = 0; a < B; ++a) {
+      if constexpr (T.moment) acc.Dm[a] = acc.W;
+      if constexpr (T.gradient) acc.Gr[a] = acc.W;
+    }
+    Real md[Dim] = {}, gd[Dim] = {};
+    prefix_rows<0, T>(st, wd, stride, st.base_node, rows, Real(1), md, gd, acc);
+    Real w_last[S], wd_last[S], dw_last[S];
+    for (int k = 0; k < S; ++k) {
+      w_last[k] = st.w(B, k);
+      wd_last[k] = wd[k][B];
+      dw_last[k] = st.dw(B, k);
+    }
+    out.W = reduce_last<GR>(acc.W, w_last);
+    for (int a = 0; a < B; ++a) {
+      if constexpr (T.moment) out.Dm[a] = reduce_last<GR>(acc.Dm[a], w_last);
+      if constexpr (T.gradient) out.Gr[a] = reduce_last<GR>(acc.Gr[a], w_last);
+    }
+    if constexpr (T.moment) out.Dm[B] = reduce_last<GR>(acc.W, wd_last);
+    if constexpr (T.gradient) out.Gr[B] = reduce_last<GR>(acc.W, dw_last);
+  }
+  // Along the last axis: sum_k c_k (row k of the strip), c_k the factor of node k.
+  template <class GR, class L>
+  MPMTB_INLINE static GR reduce_last(const L& strip, const Real (&c)[S]) {
+    constexpr int N = GR::count;
+    GR r = GR::zero();
+    r.add_scaled(c[0], strip.template segment<0, N>());
+    if constexpr (S > 1) r.add_scaled(c[1], strip.template segment<N, N>());
+    if constexpr (S > 2) r.add_scaled(c[2], strip.template segment<2 * N, N>());
+    if constexpr (S > 3) r.add_scaled(c[3], strip.template segment<3 * N, N>());
+    static_assert(S <= 4, "kernels of up to 4 nodes per axis");
+    return r;
+  }
+  // Axis A < Dim - 1 of the rows' prefix: w = prod_{b<A} w_b, md[a] (gd[a]) the
+  // same product with w_a d_a (dw_a) for axis a < A.
   template <int A, TensorTerms T>
-  MPMTB_INLINE static inline void gather_axis(const St& st, const Real (&wd)[Dim][S],
+  MPMTB_INLINE static void prefix_rows(const St& st, const AxisPack (&wd)[S],
+                                       const std::array<long, Dim>& stride, long node,
+                                       const Real* __restrict rows, Real w, const Real (&md)[Dim],
+                                       const Real (&gd)[Dim], RowSums<T>& acc) {
+    using L = typename RowSums<T>::L;
+    constexpr int N = VR<T>::N;
+    if constexpr (A == Dim - 1) {
+      const L row = L::load(rows + node * N);
+      acc.W = L::fma(w, row, acc.W);
+      for (int a = 0; a < A; ++a) {
+        if constexpr (T.moment) acc.Dm[a] = L::fma(md[a], row, acc.Dm[a]);
+        if constexpr (T.gradient) acc.Gr[a] = L::fma(gd[a], row, acc.Gr[a]);
+      }
+    } else {
+      for (int k = 0; k < S; ++k) {
+        const Real wk = st.w(A, k);
+        Real md2[Dim], gd2[Dim];
+        for (int a = 0; a < A; ++a) {
+          if constexpr (T.moment) md2[a] = md[a] * wk;
+          if constexpr (T.gradient) gd2[a] = gd[a] * wk;
+        }
+        if constexpr (T.moment) md2[A] = w * wd[k][A];
+        if constexpr (T.gradient) gd2[A] = w * st.dw(A, k);
+        prefix_rows<A + 1, T>(st, wd, stride, node + k * stride[A], rows, w * wk, md2, gd2, acc);
+      }
+    }
+  }
+
+  template <int A, TensorTerms T>
+  MPMTB_INLINE static inline void gather_axis(const St& st, const AxisPack (&wd)[S],
                                               const std::array<long, Dim>& stride, long node,
                                               const Real* __restrict rows, Vec<Dim>* nodal, int j,
                                               Real w_before, Partial<T>& out) {
@@ -305,8 +437,8 @@ class TensorTransfer {
       if constexpr (T.gradient) out.Gr[a] = GR::zero();
     }
     for (int k = 0; k < S; ++k) {
-      const Real w = st.w[A][k];
-      const long n = node + k * stride[A];
+      const Real w = st.w(A, k);
+      const long n = node + k * (A == Dim - 1 ? 1 : stride[A]);  // (as in scatter_axis)
       if constexpr (A == Dim - 1) {
         const GR u = GR::load(rows + n * N);
         if constexpr (T.nodal) {
@@ -314,14 +446,14 @@ class TensorTransfer {
           for (int a = 0; a < Dim; ++a) nodal[j * S + k][a] = w_ip * rows[n * N + a];
         }
         out.W.add_scaled(w, u);
-        if constexpr (T.moment) out.Dm[A].add_scaled(wd[A][k], u);
-        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw[A][k], u);
+        if constexpr (T.moment) out.Dm[A].add_scaled(wd[k][A], u);
+        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw(A, k), u);
       } else {
         Partial<T> sub;
         gather_axis<A + 1, T>(st, wd, stride, n, rows, nodal, j * S + k, w_before * w, sub);
         out.W.add_scaled(w, sub.W);
-        if constexpr (T.moment) out.Dm[A].add_scaled(wd[A][k], sub.W);
-        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw[A][k], sub.W);
+        if constexpr (T.moment) out.Dm[A].add_scaled(wd[k][A], sub.W);
+        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw(A, k), sub.W);
         for (int a = A + 1; a < Dim; ++a) {
           if constexpr (T.moment) out.Dm[a].add_scaled(w, sub.Dm[a]);
           if constexpr (T.gradient) out.Gr[a].add_scaled(w, sub.Gr[a]);

@@ -42,16 +42,18 @@ struct CubicKernel {
 
   // N and dN at the support's 4 nodes, r_k = r0 - k with r0 in [1, 2) the
   // offset to the first node: the branches of N resolved once (same formulas).
-  static void weights(Real r0, Real* w, Real* dw) {
-    const Real b0 = 2 - r0, a1 = r0 - 1, a2 = 2 - r0, b3 = r0 - 1;
-    w[0] = b0 * b0 * b0 / 6;
-    dw[0] = -b0 * b0 / 2;
+  // T is Real, or a SIMD pack of the axes' r0 (Stencil computes all axes at once).
+  template <class T>
+  static void weights(T r0, T* w, T* dw) {
+    const T b0 = Real(2) - r0, a1 = r0 - Real(1), a2 = Real(2) - r0, b3 = r0 - Real(1);
+    w[0] = b0 * b0 * b0 / Real(6);
+    dw[0] = -b0 * b0 / Real(2);
     w[1] = Real(0.5) * a1 * a1 * a1 - a1 * a1 + Real(2) / 3;
-    dw[1] = Real(1.5) * a1 * a1 - 2 * a1;
+    dw[1] = Real(1.5) * a1 * a1 - Real(2) * a1;
     w[2] = Real(0.5) * a2 * a2 * a2 - a2 * a2 + Real(2) / 3;
-    dw[2] = -(Real(1.5) * a2 * a2 - 2 * a2);
-    w[3] = b3 * b3 * b3 / 6;
-    dw[3] = b3 * b3 / 2;
+    dw[2] = -(Real(1.5) * a2 * a2 - Real(2) * a2);
+    w[3] = b3 * b3 * b3 / Real(6);
+    dw[3] = b3 * b3 / Real(2);
   }
 };
 

@@ -39,12 +39,14 @@ struct QuadraticKernel {
 
   // N and dN at the support's 3 nodes, r_k = r0 - k with r0 in [1/2, 3/2) the
   // offset to the first node: the branches of N resolved once (same formulas).
-  static void weights(Real r0, Real* w, Real* dw) {
-    const Real b = Real(1.5) - r0, r1 = r0 - 1, c = r0 - Real(0.5);
+  // T is Real, or a SIMD pack of the axes' r0 (Stencil computes all axes at once).
+  template <class T>
+  static void weights(T r0, T* w, T* dw) {
+    const T b = Real(1.5) - r0, r1 = r0 - Real(1), c = r0 - Real(0.5);
     w[0] = Real(0.5) * b * b;
     dw[0] = -b;
     w[1] = Real(0.75) - r1 * r1;
-    dw[1] = -2 * r1;
+    dw[1] = Real(-2) * r1;
     w[2] = Real(0.5) * c * c;
     dw[2] = c;
   }

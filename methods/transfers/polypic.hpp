@@ -20,6 +20,7 @@
 
 #include <algorithm>
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <string_view>
 #include <utility>
@@ -72,8 +73,12 @@ struct PolyModes {
     const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
     Lanes u[S], w[S], power[S], q[S][S], norm_n[S], inv_norm[S];
     for (int k = 0; k < S; ++k) {
-      u[k] = w[k] = Lanes{};
-      for (int a = 0; a < Dim; ++a) u[k][a] = st.d[a][k] * inv_dx, w[k][a] = st.w[a][k];
+      // Set whole, from arrays: lane by lane into a zero pack, GCC reports the
+      // lanes not yet set as maybe uninitialized once the gather is inlined.
+      Real u_k[kPad] = {}, w_k[kPad] = {};
+      for (int a = 0; a < Dim; ++a) u_k[a] = st.d(a, k) * inv_dx, w_k[a] = st.w(a, k);
+      std::memcpy(&u[k], u_k, sizeof(Lanes));
+      std::memcpy(&w[k], w_k, sizeof(Lanes));
       power[k] = 1 - Lanes{};
     }
     auto dropped = zero < zero;  // all lanes false
@@ -105,7 +110,7 @@ struct PolyModes {
         for (int k = 0; k < S; ++k) e[a][n][k] = q[n][k][a], unit[a][n][k] = q[n][k][a] * inv_root;
         if (n == 1) root_norm[a] = norm_n[1][a] * inv_root;  // sqrt(norm), 0 if dropped
       }
-      d0[a] = st.d[a][0];
+      d0[a] = st.d(a, 0);
     }
   }
 

@@ -30,16 +30,16 @@ void check_modes(Real x, Real dx) {
   constexpr int S = Kernel::support;
   for (int k = 0; k < S; ++k) {
     EXPECT_EQ(modes.e[0][0][k], 1);
-    EXPECT_NEAR(modes.e[0][1][k], st.d[0][k] / dx, 1e-14);
+    EXPECT_NEAR(modes.e[0][1][k], st.d(0, k) / dx, 1e-14);
   }
   for (int n = 0; n < S; ++n) {
     if (modes.norm[0][n] == 0) continue;
     Real nn = 0;
-    for (int k = 0; k < S; ++k) nn += st.w[0][k] * modes.e[0][n][k] * modes.e[0][n][k];
+    for (int k = 0; k < S; ++k) nn += st.w(0, k) * modes.e[0][n][k] * modes.e[0][n][k];
     EXPECT_NEAR(modes.norm[0][n], nn, 1e-14);
     for (int m = 0; m < n; ++m) {
       Real dot = 0;
-      for (int k = 0; k < S; ++k) dot += st.w[0][k] * modes.e[0][n][k] * modes.e[0][m][k];
+      for (int k = 0; k < S; ++k) dot += st.w(0, k) * modes.e[0][n][k] * modes.e[0][m][k];
       EXPECT_LE(std::abs(dot), 1e-15) << Kernel::name << " modes " << n << ", " << m;
     }
   }
