@@ -118,7 +118,9 @@ resume)
   pid=$!
   runs="$work/b/convergence/runs"
   for _ in $(seq 1 600); do
-    n=$(find "$runs" -name done.json 2>/dev/null | wc -l)
+    # (find fails until the suite has made the folder: with pipefail that
+    # failure would end this script under set -e)
+    n=$(find "$runs" -name done.json 2>/dev/null | wc -l || true)
     [ "$n" -ge 12 ] && break
     sleep 0.02
   done

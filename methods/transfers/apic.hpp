@@ -27,15 +27,17 @@ class ApicPolicy {
  public:
   ApicPolicy(Parameters&, Real dx) : moments_(dx) {}
 
+  // C_p and tau_p V_p are read in place: copies on the stack, read back by
+  // columns, stalled P2G's set-up on store forwarding (perf).
   struct Source {
     Real m;
     V mv;
-    M mC;
-    M tauV;
+    const M& C;
+    const M& tauV;
     V D_inv = V::Zero();  // D_p^-1, for kernels whose D_p differs per particle (uGIMP)
   };
   Source prepare(const Particles<Dim>& P, int p, const M& tauV) const {
-    return {P.m[p], P.m[p] * P.v[p], P.m[p] * P.C[p], tauV};
+    return {P.m[p], P.m[p] * P.v[p], P.C[p], tauV};
   }
   // The base solver calls this form when it exists: it adds the particle's D_p^-1.
   Source prepare(const Particles<Dim>& P, int p, const M& tauV,
@@ -95,12 +97,13 @@ class ApicPolicy {
   void momentum_form(const Source& s, ScatterForm<Dim>& form) const {
     form.alpha[F_::m] = s.m;
     form.alpha.template segment<Dim>(F_::p) = s.mv;
-    for (int a = 0; a < Dim; ++a) form.gamma[a].template segment<Dim>(F_::p) = s.mC.col(a);
+    for (int a = 0; a < Dim; ++a) form.gamma[a].template segment<Dim>(F_::p) = s.m * s.C.col(a);
   }
   // m_i += w m_p, p_i += w m_p (v_p + C_p (x_i - x_p)): shared with MLS-MPM.
   void scatter_momentum(const Source& s, Real w, const V& d, Real& m_i, V& p_i) const {
     m_i += w * s.m;
-    p_i += w * s.mv + s.mC * (w * d);
+    const M mC = s.m * s.C;
+    p_i += w * s.mv + mC * (w * d);
   }
   AffineMoments<Dim, Kernel> moments_;
 };

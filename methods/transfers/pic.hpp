@@ -29,7 +29,7 @@ class PicPolicy {
   struct Source {
     Real m;
     V mv;
-    M tauV;
+    const M& tauV;  // read in place (as ApicPolicy's)
   };
   Source prepare(const Particles<Dim>& P, int p, const M& tauV) const {
     return {P.m[p], P.m[p] * P.v[p], tauV};
