@@ -55,15 +55,18 @@ inline Mat<2> rotation2(Real c, Real s) {
 }
 // |(a, b)| without hypot's cost where the squares neither overflow nor
 // underflow (every deformation gradient of a run), hypot beyond.
+// Exact zero too (an undeformed or rigidly moving F has no reflection part).
 inline Real norm2(Real a, Real b) {
   const Real s = a * a + b * b;
   constexpr Real lo = Real(1e-30), hi = Real(1e30);
-  return s > lo && s < hi ? std::sqrt(s) : std::hypot(a, b);
+  if (s > lo && s < hi) return std::sqrt(s);
+  return a == 0 && b == 0 ? Real(0) : std::hypot(a, b);
 }
 // (cos, sin) of the angle of (x, y) at radius n (atan2's angle; 0 at the origin).
 inline void unit2(Real x, Real y, Real n, Real& c, Real& s) {
   if (n > 0) {
-    c = x / n, s = y / n;
+    const Real inv = 1 / n;
+    c = x * inv, s = y * inv;
   } else {
     c = 1, s = 0;
   }
