@@ -38,6 +38,12 @@ class ConstitutiveModel {
   virtual void initial_state(Real* /*q*/) const {}
   // Names of the internal variables, in order (for output).
   virtual std::vector<std::string> state_names() const { return {}; }
+  // Material directions, for anisotropic models: how many fibre families the
+  // model takes (0: none; a model that takes any needs at least one, a body's
+  // `fiber`), and set_fibers writes them (nonzero, in the reference
+  // configuration) into a particle's state after initial_state.
+  virtual int fiber_families() const { return 0; }
+  virtual void set_fibers(Real* /*q*/, std::span<const Vec<Dim>> /*a0*/) const {}
   // Nonlocal models only (see LaplacianRequest); local models ask for nothing.
   virtual LaplacianRequest laplacian_request() const { return {}; }
   // The largest wave speed over the particles `ids` in their current state
