@@ -365,11 +365,18 @@ TEST(AnisoDamageScene, BadFiberInputIsRejectedByName) {
   std::string negative = spinning_toml("[1.0, 0.0, 0.0]");
   negative.replace(negative.find("alpha = 3.0"), 11, "alpha = -1.0");
   expect_error(negative, {"materials.wood", "alpha"});
-  // A valid grain is normalised.
+  std::string second_only = spinning_toml("[1.0, 0.0, 0.0]");
+  second_only.replace(second_only.find("fiber = "), 8, "fiber2 = ");
+  expect_error(second_only, {"bodies[0].fiber2", "give `fiber` first"});
+  // A valid grain is normalised; a second family is kept, and absent is zero.
   const State<2> s = build_state<2>(testing::scene_from_toml(spinning_toml("[3.0, 4.0, 0.0]")));
   const Vec<2> a = AnisoDamage<2>::reference_fiber(s.particles.state_of(0), 0);
   EXPECT_NEAR(a[0], 0.6, 1e-15);
   EXPECT_NEAR(a[1], 0.8, 1e-15);
+  EXPECT_EQ(AnisoDamage<2>::reference_fiber(s.particles.state_of(0), 1), Vec<2>::Zero());
+  const State<2> two = build_state<2>(
+      testing::scene_from_toml(spinning_toml("[1.0, 0.0, 0.0]\nfiber2 = [0.0, -2.0, 0.0]")));
+  EXPECT_EQ(AnisoDamage<2>::reference_fiber(two.particles.state_of(0), 1), Vec<2>(0, -1));
 }
 
 }  // namespace aniso_damage_test
