@@ -4,11 +4,33 @@
 //     evolution of models/damage.hpp, with the driving stress weighted by a
 //     structural tensor built from the material's fibre directions, and an
 //     anisotropic (fibre-reinforced) elastic energy degraded with the damage.
-//   Equation numbers are not given: they were not checked against the paper.
-//   Not here: the structural tensor in the nonlocal term, div(A grad d) in
-//   place of lap d; the step's nonlocal operator (core/nonlocal.hpp) gives the
-//   isotropic lap d only. cases/README.md (fiber_tension) reports what the
-//   stress weighting alone does to a crack's path.
+//   Teichtmeister, Kienle, Aldakheel, Keip 2017, "Phase field modeling of
+//     fracture in anisotropic brittle solids", Int. J. Non-Linear Mech. 97:
+//     the anisotropic crack density gamma = (d^2 + l0^2 grad d . A_l grad d) / (2 l0).
+//   Equation numbers are not given: they were not checked against the papers.
+// Regularisation (the length scale l0 with a grain): the damage evolution
+// takes div(A_l grad d) in place of lap d (core/nonlocal.hpp), with
+//   A_l = I + alpha sum_f a_f a_f^T.
+// Why this sign (worked on paper): across a straight damage band of unit
+// normal n, d = d(s), s = x . n, so grad d . A_l grad d = m d'^2 with
+// m = n . A_l n; the optimal profile is d = exp(-|s| / (l0 sqrt m)), of width
+// l0 sqrt m, and the regularised surface energy per unit area is
+// int gamma ds = sqrt(m): the crack prefers the normal that minimises n . A_l n.
+// With A_l = I + alpha a a^T, n . A_l n = 1 + alpha (n . a)^2 is least (1) for
+// n normal to the fibre, i.e. for a crack running ALONG the fibre; damage
+// diffuses 1 + alpha times as fast along a as across it, so a crack tip's
+// process zone reaches ahead along the grain. The driver's form
+// I + alpha (I - a a^T) below would, in the regularisation, make n . A n =
+// 1 + alpha (1 - (n . a)^2) least for n ALONG the fibre, a crack ACROSS it:
+// the wrong way. Teichtmeister et al. write A = I + alpha (I - m m^T) with m the
+// normal of the preferred cleavage plane; with m normal to the fibre in 2D
+// that is I + alpha a a^T, the form here (in 3D, I + alpha a a^T favours every
+// plane containing the fibre and lets the load choose among them).
+// The same reasoning checks the driver: sigma~ = A sigma A with
+// A = I + alpha (I - a a^T) scales the normal stress b . sigma b on planes of
+// normal b perpendicular to the fibre by (1 + alpha)^2, and leaves that on the
+// plane normal to the fibre alone: tension opening a crack ALONG the fibres
+// drives damage hardest. Both tensors favour the same cracks.
 // Fibres: one or two families of unit directions a0_f per particle, given in
 // the reference configuration (a body's `fiber`, `fiber2`). The current
 // direction is the pushed-forward fibre renormalised, a_f = F a0_f / |F a0_f|:
@@ -24,8 +46,9 @@
 // the same tension along them (the material splits along its grain).
 // Driver: sigma~ = A sigma A (sigma the undamaged Cauchy stress, fibre part
 // included), phi = (largest principal value of sigma~) / sigma_crit,
-// D~ = zeta <phi - 1>, and the rate law, the length scale l0 and the linearly
-// implicit update of models/damage.hpp unchanged.
+// D~ = zeta <phi - 1>, and the rate law and the linearly implicit update of
+// models/damage.hpp, with div(A_l grad d) for lap d and its grid diagonal for
+// 2 Dim / dx^2 (alpha = 0: lap d itself, the isotropic path of the step).
 // Energy: psi = g(d) psi_m+ + g_f(d) psi_f + psi_m-, with psi_m+/- the
 // neo-Hookean tension/compression split of models/damage.hpp, g(d) its
 // degradation, g_f(d) = (1 - d)^2 (1 - fiber_k) + fiber_k that of the fibres
@@ -87,6 +110,7 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
   year = {2016}
 })bib";
   static constexpr int kFamilies = 2;
+  static_assert(kFamilies <= LaplacianRequest::kMaxFibers, "the step reads at most kMaxFibers");
   enum StateIndex { kDamage = 0, kDissipated = 1, kLapDamage = 2, kLapDiagonal = 3, kFibers = 4 };
   // Where family f's reference (a0) and current (a) directions sit in the state.
   static constexpr int ref_at(int f) { return kFibers + 2 * Dim * f; }
@@ -96,7 +120,8 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
       : m_(params),
         alpha_(params.optional("alpha", 0, Range::non_negative())),
         fiber_E_(params.optional("fiber_E", 0, Range::non_negative())),
-        fiber_k_(params.optional("fiber_k", 1e-6, Range::closed(0, 1))) {}
+        fiber_k_(params.optional("fiber_k", 1e-6, Range::closed(0, 1))),
+        alpha_l_(params.optional("alpha_l", alpha_, Range::non_negative())) {}
 
   std::string_view name() const override { return model_name; }
   Real density() const override { return m_.density(); }
@@ -120,7 +145,15 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
     }
     return names;
   }
-  LaplacianRequest laplacian_request() const override { return m_.laplacian_request(); }
+  // div(A_l grad d), A_l = I + alpha_l sum_f a_f a_f^T of the current fibres;
+  // alpha_l = 0 asks for the `damage` model's isotropic lap d.
+  LaplacianRequest laplacian_request() const override {
+    LaplacianRequest r = m_.laplacian_request();
+    if (!r.active() || alpha_l_ == 0) return r;
+    r.alpha = alpha_l_;
+    for (int f = 0; f < kFamilies; ++f) r.fibers[f] = cur_at(f);
+    return r;
+  }
   int fiber_families() const override { return kFamilies; }
   // a0: one or two nonzero directions (normalised here).
   void set_fibers(Real* q, std::span<const Vec<Dim>> a0) const override {
@@ -265,7 +298,7 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
   }
 
   Matrix m_;
-  Real alpha_, fiber_E_, fiber_k_;
+  Real alpha_, fiber_E_, fiber_k_, alpha_l_;
 };
 
 }  // namespace mpmtb
