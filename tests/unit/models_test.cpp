@@ -66,7 +66,8 @@ const std::map<std::string, std::vector<std::pair<std::string, Real>>> kInvalid 
       {"fiber_E", -1},
       {"fiber_k", 1.5},
       {"fiber_k", -0.1},
-      {"l0", -1}}}};
+      {"l0", -1},
+      {"alpha_l", -1}}}};
 
 std::map<std::string, Real> ValidParams(const std::string& model) {
   std::map<std::string, Real> v = {{"E", kE}, {"nu", kNu}, {"density", kRho}};
