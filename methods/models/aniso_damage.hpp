@@ -67,6 +67,7 @@
 // Objective: psi depends on F through F^T F and a0 only; under F -> R F,
 // a -> R a, A -> R A R^T and sigma~ -> R sigma~ R^T keep their eigenvalues.
 // Parameters: those of `damage`, plus alpha >= 0 (0: isotropic driver),
+// alpha_l >= 0 (alpha; the grain of the length scale, 0: the isotropic lap d),
 // fiber_E >= 0 (0; a modulus: the fibres' stiffness in tension) and fiber_k in
 // [0, 1] (1e-6). The P-wave speed along the fibres,
 // sqrt((lambda + 2 mu + fiber_E) / rho), sets the CFL.
