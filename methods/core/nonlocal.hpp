@@ -1,7 +1,8 @@
 // Grid Laplacian of a particle state variable, for nonlocal (gradient-
 // regularised) models such as the damage length scale of AnisoMPM (Wolper,
 // Chen, Li, Fang, Jiang 2020, "AnisoMPM", ACM TOG 39(4): the l0^2 lap d term
-// of the damage evolution; REFERENCE.md "Damage").
+// of the damage evolution; REFERENCE.md "Damage"), and its anisotropic form
+// div(A grad q) for a grain in the length scale (below).
 //
 // A model asks for it through ConstitutiveModel::laplacian_request(): the
 // step calls apply() after G2P (positions at time n+1) and before return_map.
