@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <cmath>
 #include <filesystem>
 #include <fstream>
 #include <sstream>
@@ -148,6 +149,50 @@ int material_index(const Scene& s, const std::string& name, const std::string& f
       fmt::format("{}: unknown material '{}'; defined: {}", field, name, fmt::join(names, ", ")));
 }
 
+// A body's `fiber` (and `fiber2`): nonzero in the scene's dimensions, zero in
+// the others, normalised; only for a material whose model takes fibres, which
+// then needs at least `fiber`.
+void read_fibers(TableReader& r, const Scene& s, const std::string& path, BodySpec& b) {
+  for (const char* key : {"fiber", "fiber2"}) {
+    if (!r.has(key)) continue;
+    if (b.fibers.empty() && std::string(key) == "fiber2")
+      throw InputError(
+          fmt::format("{}.fiber2: give `fiber` first (fiber2 is a second family)", path));
+    Vec3 a = r.vec3(key);
+    for (int i = s.dim; i < 3; ++i) {
+      if (a[i] != 0) {
+        throw InputError(
+            fmt::format("{}.{}: component {} must be 0 in {}D, got {}", path, key, i, s.dim, a[i]));
+      }
+    }
+    if (!(a.norm() > 0) || !std::isfinite(a.norm())) {
+      throw InputError(
+          fmt::format("{}.{}: the fibre direction must be a nonzero finite vector [ax, ay, az], "
+                      "got [{}, {}, {}]",
+                      path, key, a[0], a[1], a[2]));
+    }
+    b.fibers.push_back(a.normalized());
+  }
+  const MaterialSpec& m = s.materials[b.material];
+  Parameters probe = m.params;
+  const int families = make_model<1>(m.model, probe)->fiber_families();
+  if (families == 0 && !b.fibers.empty()) {
+    throw InputError(fmt::format(
+        "{}.fiber: material '{}' uses model '{}', which takes no fibre direction (models with "
+        "fibres: aniso-damage)",
+        path, m.name, m.model));
+  }
+  if (families > 0 && b.fibers.empty()) {
+    throw InputError(fmt::format(
+        "{}: material '{}' uses model '{}', which needs the fibre direction `fiber = [ax, ay, az]`",
+        path, m.name, m.model));
+  }
+  if (static_cast<int>(b.fibers.size()) > families) {
+    throw InputError(
+        fmt::format("{}.fiber2: model '{}' takes {} fibre family", path, m.model, families));
+  }
+}
+
 void read_bodies(TableReader& top, Scene& s) {
   const auto bodies = top.table_array("bodies");
   for (std::size_t i = 0; i < bodies.size(); ++i) {
@@ -173,6 +218,17 @@ void read_bodies(TableReader& top, Scene& s) {
     b.material = material_index(s, r.string("material"), path + ".material");
     b.velocity = r.vec3_or("velocity", Vec3::Zero());
     b.angular_velocity = r.vec3_or("angular_velocity", Vec3::Zero());
+    if (r.has("cut_min") || r.has("cut_max")) {
+      b.cut_min = r.vec3("cut_min");
+      b.cut_max = r.vec3("cut_max");
+      for (int a = 0; a < s.dim; ++a) {
+        if (!(b.cut_max[a] > b.cut_min[a])) {
+          throw InputError(fmt::format("{}.cut_max[{}] must exceed {}.cut_min[{}] (give both)",
+                                       path, a, path, a));
+        }
+      }
+    }
+    read_fibers(r, s, path, b);
     r.finish();
     Vec3 lo, hi;
     b.bounds(lo, hi);
@@ -253,6 +309,9 @@ Vec3 BodySpec::rotation_center() const {
 }
 
 bool BodySpec::contains(const Vec3& x, int dim) const {
+  bool in_cut = cut_max[0] > cut_min[0];
+  for (int a = 0; a < dim && in_cut; ++a) in_cut = x[a] >= cut_min[a] && x[a] < cut_max[a];
+  if (in_cut) return false;
   if (shape == "box") {
     for (int a = 0; a < dim; ++a) {
       if (x[a] < min[a] || x[a] >= max[a]) return false;

@@ -32,6 +32,12 @@ struct BodySpec {
   int material = 0;
   Vec3 velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();  // about the body's centre; 2D uses z
+  // A box cut out of the body (`cut_min`, `cut_max`: a notch or a slot); empty when
+  // cut_max does not exceed cut_min.
+  Vec3 cut_min = Vec3::Zero(), cut_max = Vec3::Zero();
+  // Material (fibre) directions, unit length in the scene's dimension: `fiber`
+  // and optionally `fiber2`, for models that take them (aniso-damage).
+  std::vector<Vec3> fibers;
   Vec3 rotation_center() const;
   bool contains(const Vec3& x, int dim) const;
   // Axis-aligned bounding box.

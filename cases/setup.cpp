@@ -43,8 +43,10 @@ bool pinned_at(const Scene& scene, const Vec3& x) {
       index(a), index(b), x[0], x[1], x[2]));
 }
 
+// Seeds the lattice points inside the bodies; returns each particle's body.
 template <int Dim>
-void seed_particles(const Scene& scene, State<Dim>& s) {
+std::vector<const BodySpec*> seed_particles(const Scene& scene, State<Dim>& s) {
+  std::vector<const BodySpec*> body_of;
   const GridGeometry<Dim>& geo = s.grid.geo;
   const int ppc = scene.ppc;
   const Real h = geo.dx / ppc;  // lattice spacing
@@ -69,9 +71,11 @@ void seed_particles(const Scene& scene, State<Dim>& s) {
       const Real rho = s.materials[owner->material]->density();
       s.particles.add(head<Dim>(x), rigid_velocity<Dim>(*owner, x), rho * volume, volume,
                       owner->material, pinned_at<Dim>(scene, x));
+      body_of.push_back(owner);
     }
   }
   if (s.particles.size() == 0) throw InputError("bodies: no particle lies inside any body");
+  return body_of;
 }
 
 }  // namespace
@@ -106,9 +110,15 @@ State<Dim> build_state(const Scene& scene) {
   }
   s.gravity = head<Dim>(scene.gravity);
   s.colliders.spheres = scene.colliders;
-  seed_particles(scene, s);
+  const std::vector<const BodySpec*> body_of = seed_particles(scene, s);
   for (std::size_t p = 0; p < s.particles.size(); ++p) {
-    s.materials[s.particles.material[p]]->initial_state(s.particles.state_of(p));
+    const auto& model = *s.materials[s.particles.material[p]];
+    model.initial_state(s.particles.state_of(p));
+    if (!body_of[p]->fibers.empty()) {  // read_scene checked that the model takes them
+      std::vector<Vec<Dim>> a0;
+      for (const Vec3& a : body_of[p]->fibers) a0.push_back(head<Dim>(a).normalized());
+      model.set_fibers(s.particles.state_of(p), a0);
+    }
   }
   s.index_materials();
   return s;

@@ -2,6 +2,7 @@
 
 #include "models/registry.hpp"
 #include "references/column.hpp"
+#include "references/crack.hpp"
 #include "references/manufactured.hpp"
 #include "references/vibrating_bar.hpp"
 #include "scene.hpp"
@@ -9,7 +10,7 @@
 namespace mpmtb {
 
 std::vector<std::string> reference_kinds() {
-  return {"vibrating-bar", "mms-bar", "mms-axis", "column"};
+  return {"vibrating-bar", "mms-bar", "mms-axis", "column", "crack"};
 }
 
 template <int Dim>
@@ -25,6 +26,7 @@ std::unique_ptr<Reference<Dim>> make_reference(const Scene& scene) {
     return std::make_unique<ManufacturedReference<Dim>>(scene, scene.reference);
   }
   if (scene.reference == "column") return std::make_unique<ColumnCollapse<Dim>>(scene);
+  if (scene.reference == "crack") return std::make_unique<CrackGeometry<Dim>>(scene);
   return nullptr;  // unreachable: read_scene accepts only reference_kinds()
 }
 

@@ -120,7 +120,10 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   }
 
   Real sigma_crit() const { return sigma_crit_; }
+  Real zeta() const { return zeta_; }
+  Real eta() const { return eta_; }
   Real l0() const { return l0_; }
+  const ElasticConstants& elastic() const { return c_; }
   Real degradation(Real d) const { return (1 - d) * (1 - d) * (1 - k_) + k_; }
 
   // The tensile (degraded) and compressive (kept) parts of the energy.

@@ -4,6 +4,7 @@
 // writes the batch loops once over the model's per-particle formulas.
 #pragma once
 
+#include <array>
 #include <memory>
 #include <span>
 #include <string>
@@ -17,11 +18,19 @@ namespace mpmtb {
 
 // What a nonlocal model asks of the step (core/nonlocal.hpp): the grid
 // Laplacian of its state variable q[source], written to q[target] together
-// with the grid operator's diagonal magnitude 2 Dim / dx^2 in q[target + 1],
-// after G2P and before return_map.
+// with the grid operator's diagonal magnitude (2 Dim / dx^2 for lap q) in
+// q[target + 1], after G2P and before return_map.
+// Anisotropic (alpha > 0 and fibers[0] >= 0): div(A grad q) instead of lap q,
+// with the per-particle symmetric tensor A_p = I + alpha sum_f a_f a_f^T built
+// from the unit directions a_f stored at q[fibers[f]] .. q[fibers[f] + Dim - 1]
+// (a family with a zero vector, or index -1, is left out).
 struct LaplacianRequest {
+  static constexpr int kMaxFibers = 2;
   int source = -1, target = -1;
+  Real alpha = 0;
+  std::array<int, kMaxFibers> fibers{-1, -1};
   bool active() const { return source >= 0; }
+  bool anisotropic() const { return active() && alpha > 0 && fibers[0] >= 0; }
 };
 
 template <int Dim>
@@ -38,6 +47,12 @@ class ConstitutiveModel {
   virtual void initial_state(Real* /*q*/) const {}
   // Names of the internal variables, in order (for output).
   virtual std::vector<std::string> state_names() const { return {}; }
+  // Material directions, for anisotropic models: how many fibre families the
+  // model takes (0: none; a model that takes any needs at least one, a body's
+  // `fiber`), and set_fibers writes them (nonzero, in the reference
+  // configuration) into a particle's state after initial_state.
+  virtual int fiber_families() const { return 0; }
+  virtual void set_fibers(Real* /*q*/, std::span<const Vec<Dim>> /*a0*/) const {}
   // Nonlocal models only (see LaplacianRequest); local models ask for nothing.
   virtual LaplacianRequest laplacian_request() const { return {}; }
   // The largest wave speed over the particles `ids` in their current state

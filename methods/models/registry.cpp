@@ -38,6 +38,7 @@ const std::vector<ModelEntry>& entries() {
       entry<Snow>("fixed-corotated snow plasticity, theta_c theta_s xi (Stomakhin et al. 2013)"),
       entry<Sand>("Drucker-Prager sand on Hencky StVK, friction_angle h1 h2 h3 (Klar et al. 2016)"),
       entry<Damage>("isotropic damage, neo-Hookean tension split (CD-MPM 2019, AnisoMPM 2020)"),
+      entry<AnisoDamage>("fibre damage: structural tensor alpha, fibre stiffness (AnisoMPM 2020)"),
   };
   return list;
 }

@@ -43,7 +43,7 @@ constexpr Real kLambda = kE * kNu / ((1 + kNu) * (1 - 2 * kNu));
 const std::set<std::string> kNotFrameIndifferent = {"linear-elastic"};
 // Parameters without a default that a model needs beyond E, nu, density.
 const std::map<std::string, std::map<std::string, Real>> kRequired = {
-    {"damage", {{"sigma_crit", 10}}}};
+    {"damage", {{"sigma_crit", 10}}}, {"aniso-damage", {{"sigma_crit", 10}}}};
 // Values every model must reject (naming the key), then model-specific ones.
 const std::vector<std::pair<std::string, Real>> kInvalidElastic = {
     {"E", 0},    {"E", -5},  {"E", std::nan("")}, {"nu", 0.5},
@@ -59,7 +59,15 @@ const std::map<std::string, std::vector<std::pair<std::string, Real>>> kInvalid 
       {"h3", 30},
       {"h3", -1},
       {"h1", 1000}}},
-    {"damage", {{"sigma_crit", 0}, {"zeta", 0}, {"eta", 0}, {"k", 1}, {"k", -0.1}}}};
+    {"damage", {{"sigma_crit", 0}, {"zeta", 0}, {"eta", 0}, {"k", 1}, {"k", -0.1}}},
+    {"aniso-damage",
+     {{"sigma_crit", 0},
+      {"alpha", -1},
+      {"fiber_E", -1},
+      {"fiber_k", 1.5},
+      {"fiber_k", -0.1},
+      {"l0", -1},
+      {"alpha_l", -1}}}};
 
 std::map<std::string, Real> ValidParams(const std::string& model) {
   std::map<std::string, Real> v = {{"E", kE}, {"nu", kNu}, {"density", kRho}};
