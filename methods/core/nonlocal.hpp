@@ -152,19 +152,23 @@ class NonlocalLaplacian {
       if (!requested(P, p)) return;
       const LaplacianRequest& r = requests_[P.material[p]];
       const Real mp = P.m[p], mq = mp * P.state_of(p)[r.source];
-      StencilT(P.x[p], geo)
-          .for_each_node(geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
-            m_[node] += w * mp;
-            q_[node] += w * mq;
-          });
-      if (!aniso_) return;  // the isotropic path ends here, as it always did
+      const StencilT st(P.x[p], geo);
+      const auto add_mq = [&](long node, Real w) {
+        m_[node] += w * mp;
+        q_[node] += w * mq;
+      };
+      if (!aniso_) {  // the isotropic path, as it always was
+        st.for_each_node(
+            geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) { add_mq(node, w); });
+        return;
+      }
       const Mat<Dim> mA = mp * structural_tensor(r, P.state_of(p));
-      StencilT(P.x[p], geo)
-          .for_each_node(geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
-            for (int a = 0; a < Dim; ++a) {
-              for (int b = a; b < Dim; ++b) A_[comp(a, b)][node] += w * mA(a, b);
-            }
-          });
+      st.for_each_node(geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+        add_mq(node, w);
+        for (int a = 0; a < Dim; ++a) {
+          for (int b = a; b < Dim; ++b) A_[comp(a, b)][node] += w * mA(a, b);
+        }
+      });
     });
     box_.for_each_node(geo.strides(), [&](long i) {
       if (m_[i] > 0) q_[i] /= m_[i];

@@ -228,17 +228,7 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
     if (alpha_ == 0 && fiber_E_ == 0) return m_.project(F, q, dt);  // `damage` exactly
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
-    const Real excess = stress_excess(F, q);
-    const Real D = excess > 0 ? m_.zeta() * excess / m_.sigma_crit() : Real(0);
-    Real drive = (1 - d_old) * D - d_old, h = dt / m_.eta();
-    if (m_.l0() > 0) {
-      const Real l2 = m_.l0() * m_.l0();
-      drive += l2 * q[kLapDamage];
-      h /= 1 + h * l2 * q[kLapDiagonal];
-    }
-    const Real rate = std::max(Real(0), drive);
-    if (!(rate > 0)) return;  // also guards against NaN
-    const Real d_new = std::min(Real(1), d_old + h * rate);
+    const Real d_new = m_.advanced_damage(d_old, stress_excess(F, q), q, dt);
     if (!(d_new > d_old)) return;
     q[kDissipated] += (m_.degradation(d_old) - m_.degradation(d_new)) * m_.split(F).plus +
                       (fiber_degradation(d_old) - fiber_degradation(d_new)) * fiber_energy(F, q);

@@ -193,9 +193,17 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   void project(Mat<Dim>& F, Real* q, Real dt) const {
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
+    const Real d_new = advanced_damage(d_old, stress_excess(F), q, dt);
+    if (!(d_new > d_old)) return;
+    q[kDissipated] += (degradation(d_old) - degradation(d_new)) * split(F).plus;
+    q[kDamage] = d_new;
+  }
+  // The rate law's step from d_old < 1, driven by excess = sigma_max -
+  // sigma_crit (the nonlocal terms from q when l0 > 0); d_old when it does not
+  // grow. Shared with aniso-damage, which drives it with its weighted stress.
+  Real advanced_damage(Real d_old, Real excess, const Real* q, Real dt) const {
     // D~ = zeta <phi - 1> with phi = sigma_max / sigma_crit, written so that
     // D~ > 0 exactly when sigma_max > sigma_crit (no rounding of the quotient).
-    const Real excess = stress_excess(F);
     const Real D = excess > 0 ? zeta_ * excess / sigma_crit_ : Real(0);
     Real drive = (1 - d_old) * D - d_old, h = dt / eta_;
     if (l0_ > 0) {  // the nonlocal term; the local path is untouched otherwise
@@ -204,11 +212,8 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
       h /= 1 + h * l2 * q[kLapDiagonal];
     }
     const Real rate = std::max(Real(0), drive);
-    if (!(rate > 0)) return;  // also guards against NaN
-    const Real d_new = std::min(Real(1), d_old + h * rate);
-    if (!(d_new > d_old)) return;
-    q[kDissipated] += (degradation(d_old) - degradation(d_new)) * split(F).plus;
-    q[kDamage] = d_new;
+    if (!(rate > 0)) return d_old;  // also guards against NaN
+    return std::min(Real(1), d_old + h * rate);
   }
   Real dissipated(const Real* q) const { return q[kDissipated]; }
 
