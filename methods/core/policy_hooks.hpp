@@ -8,7 +8,8 @@
 // as before. On the fast path (core/tensor_transfer.hpp) a policy turns the
 // stencil sums into its Gather with
 //   Gather gather_from(sums)                     or, with TensorTerms::nodal,
-//   void gather_from(sums, Gather&)              after the sums filled Gather::wv.
+//   void gather_from(sums, Gather&)              after the stencil's velocity rows
+//                                                were copied to Gather::v_data().
 #pragma once
 
 #include <concepts>
@@ -57,7 +58,7 @@ MPMTB_INLINE inline typename Policy::Gather tensor_gather(const Policy& policy,
   using Sums = TensorTransfer<Dim, Kernel>;
   if constexpr (terms.nodal) {
     typename Policy::Gather gather = begin_gather(policy, st);
-    policy.gather_from(Sums::template gather<terms>(st, g, rows, gather.wv), gather);
+    policy.gather_from(Sums::template gather<terms>(st, g, rows, gather.v_data()), gather);
     return gather;
   } else {
     return policy.gather_from(Sums::template gather<terms>(st, g, rows));

@@ -154,11 +154,16 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
               : J_max, v2_max) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       const StencilT st(P.x[p], g.geo);
-      typename Policy::Gather gather;
-      if constexpr (kTensorPath) {
-        gather = tensor_gather(policy, st, g.geo, rows_.data());  // core/policy_hooks.hpp
-      } else {
-        gather = begin_gather(policy, st);  // core/policy_hooks.hpp
+      // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
+      // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
+      typename Policy::Gather gather = [&] {
+        if constexpr (kTensorPath) {
+          return tensor_gather(policy, st, g.geo, rows_.data());
+        } else {
+          return begin_gather(policy, st);
+        }
+      }();
+      if constexpr (!kTensorPath) {
         st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
           policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
         });

@@ -30,15 +30,16 @@ struct TensorTerms {
   bool moment = false;    // w_ip (x_i - x_p)
   bool gradient = false;  // grad w_ip
   bool old = false;       // gather only: sum w_ip v_i_old (FLIP)
-  // A field over the stencil's own nodes: P2G adds w_ip u_j to p_i, G2P returns
-  // w_ip v_i node by node (PolyPIC's per-node polynomial velocity).
+  // A field over the stencil's own nodes: P2G adds the policy's row for node j
+  // (already weighted: w_ip m_p v_p(x_i) for PolyPIC's polynomial velocity) to
+  // the node's sums, G2P copies the packed rows v_i of the stencil's nodes out.
   bool nodal = false;
 };
 
 // The P2G contribution to node i, stacked as (m_i, p_i, f_i, padding):
 //   w_ip alpha + sum_a gamma[a] w_ip (x_i - x_p)_a + sum_a beta[a] grad_a w_ip
-//   (+ w_ip nodal[j] in p_i with TensorTerms::nodal, j the node's index in the
-//   stencil, last axis fastest).
+//   (+ row j of nodal with TensorTerms::nodal, j the node's index in the stencil,
+//   last axis fastest).
 template <int Dim>
 struct ScatterForm {
   static constexpr int N = Dim == 1 ? 4 : 8;  // whole SIMD registers (core/pack.hpp)
@@ -46,7 +47,9 @@ struct ScatterForm {
   Col alpha;
   Col gamma[Dim];
   Col beta[Dim];
-  const Vec<Dim>* nodal = nullptr;  // Kernel::support^Dim values (TensorTerms::nodal)
+  // TensorTerms::nodal: Kernel::support^Dim rows of kNodalWidth values, added to
+  // the first kNodalWidth values of each node's sums (the m and p slots).
+  const Real* nodal = nullptr;
   // Slots of the stacked column.
   static constexpr int m = 0, p = 1, f = 1 + Dim;
 };
@@ -56,6 +59,9 @@ struct ScatterForm {
 template <int Dim>
 inline constexpr int kFoldedWidth = std::max<int>(Dim == 1 ? 2 : 4,
                                                   16 / static_cast<int>(sizeof(Real)));
+// Width of ScatterForm::nodal's rows: the (m, p) slots, padded as a folded row.
+template <int Dim>
+inline constexpr int kNodalWidth = kFoldedWidth<Dim>;
 
 // P2G's accumulator: for every grid node the stacked column (m_i, p_i, f_i,
 // padding) of ScatterForm, its N values side by side. A node's update is then a
@@ -182,19 +188,16 @@ class TensorTransfer {
   }
 
   // The sums from the packed velocities (VelocityRows<Dim, T.old>::data()); with
-  // T.nodal also nodal[j] = w_ip v_i for the stencil's nodes j (St::count values).
+  // T.nodal also the stencil's rows themselves, copied to nodal (St::count rows of
+  // VelocityRows::N values, last axis fastest).
   template <TensorTerms T>
   MPMTB_INLINE static GatherSums<Dim> gather(const St& st, const GridGeometry<Dim>& g,
                                              const Real* __restrict rows,
-                                             Vec<Dim>* nodal = nullptr) {
+                                             Real* __restrict nodal = nullptr) {
     AxisPack wd[S];  // w_a d_a of node k, axis a in lane a (as Stencil's factors)
     for (int k = 0; k < S; ++k) wd[k] = st.wk[k] * st.dk[k];
     Partial<T> part;
-    if constexpr (T.nodal) {
-      gather_axis<0, T>(st, wd, g.strides(), st.base_node, rows, nodal, 0, Real(1), part);
-    } else {
-      gather_strips<T>(st, wd, g.strides(), rows, part);
-    }
+    gather_strips<T>(st, wd, g.strides(), rows, nodal, part);
     GatherSums<Dim> out;
     Real sum[VR<T>::N];
     part.W.store(sum);
@@ -248,24 +251,31 @@ class TensorTransfer {
   }
 
   // The scatter over rows of W values per node: alpha, gamma, beta as rows,
-  // nodal (TensorTerms::nodal) the per-node momenta that go to the p slots.
+  // nodal (TensorTerms::nodal) the policy's rows per node (ScatterForm::nodal).
   template <TensorTerms T, class R>
   MPMTB_INLINE static void scatter_rows(const St& st, const GridGeometry<Dim>& g, const R& alpha,
                                         const R (&gamma)[Dim], const R (&beta)[Dim],
-                                        const Vec<Dim>* nodal_values, Real* __restrict sums) {
+                                        const Real* __restrict nodal, Real* __restrict sums) {
     AxisPack wd[S];  // w_a d_a of node k, axis a in lane a (as Stencil's factors)
     for (int k = 0; k < S; ++k) wd[k] = st.wk[k] * st.dk[k];
-    R nodal[T.nodal ? St::count : 1];
-    if constexpr (T.nodal) {
-      for (int j = 0; j < St::count; ++j) {
-        RowBuilder<R::count> row;
-        row.template segment<Dim>(Form::p) = nodal_values[j];
-        nodal[j] = row.row();
-      }
-    }
     const LastAxis<R::count> last(st, wd);
-    scatter_axis<0, T>(st, wd, last, g.strides(), st.base_node, alpha, gamma, beta, nodal, 0,
-                       Real(1), sums);
+    scatter_axis<0, T>(st, wd, last, g.strides(), st.base_node, alpha, gamma, beta, nodal, 0, sums);
+  }
+  // Row j of the stencil (the S nodes along the last axis after the leading
+  // axes' index j) of the nodal field, as a strip of S nodes of W values: the
+  // nodal rows are kNodalWidth wide, zero beyond.
+  template <int W>
+  MPMTB_INLINE static Strip<S * W> nodal_strip(const Real* __restrict nodal, int j) {
+    constexpr int NW = kNodalWidth<Dim>;
+    static_assert(NW <= W, "nodal rows fit in the sums' rows");
+    const Real* row = nodal + j * S * NW;
+    if constexpr (NW == W) {
+      return Strip<S * W>::load(row);
+    } else {
+      return Strip<S * W>::from([&](int l) MPMTB_INLINE_LAMBDA {
+        return l % W < NW ? row[l / W * NW + l % W] : Real(0);
+      });
+    }
   }
 
   // The last axis's factors w_k, w_k d_k and dw_k of node k repeated over its W
@@ -283,48 +293,39 @@ class TensorTransfer {
   // Top down: on entry to axis A, the node value is
   //   alpha prod_{b>=A} w_b + sum_{a>=A} gamma[a] (prod_{b>=A} w_b) d_a
   //                         + sum_{a>=A} beta[a] dw_a prod_{b>=A, b!=a} w_b;
-  // j is the stencil index of the axes before A, w_before = prod_{b<A} w_b.
-  template <int A, TensorTerms T, class R, int K>
+  // j is the stencil index of the axes before A.
+  template <int A, TensorTerms T, class R>
   MPMTB_INLINE static inline void scatter_axis(const St& st, const AxisPack (&wd)[S],
                                                const LastAxis<R::count>& last,
                                                const std::array<long, Dim>& stride, long node,
                                                const R& alpha, const R (&gamma)[Dim],
-                                               const R (&beta)[Dim], const R (&nodal)[K], int j,
-                                               Real w_before, Real* __restrict sums) {
+                                               const R (&beta)[Dim], const Real* __restrict nodal,
+                                               int j, Real* __restrict sums) {
     constexpr int W = R::count;  // values per node
-    if constexpr (A == Dim - 1 && !T.nodal) {
-      // The whole row of S nodes at once, lane by lane the same operations as
-      // node by node below (so the same bits): w alpha + w d gamma + dw beta.
+    if constexpr (A == Dim - 1) {
+      // The whole row of S nodes at once (the last axis is the grid's fastest,
+      // stride 1: GridGeometry): w alpha + w d gamma + dw beta, lane by lane the
+      // same operations as node by node.
       using L = Strip<S * W>;
       L al = last.w * L::repeat(alpha);
       if constexpr (T.moment) al = L::fma(last.wd, L::repeat(gamma[A]), al);
       if constexpr (T.gradient) al = L::fma(last.dw, L::repeat(beta[A]), al);
+      if constexpr (T.nodal) al = al + nodal_strip<W>(nodal, j);
       Real* out = sums + node * W;
       (L::load(out) + al).store(out);
-      return;
-    }
-    for (int k = 0; k < S; ++k) {
-      const Real w = st.w(A, k);
-      R al = w * alpha;
-      if constexpr (T.moment) al.add_scaled(wd[k][A], gamma[A]);
-      if constexpr (T.gradient) al.add_scaled(st.dw(A, k), beta[A]);
-      // The last axis is the grid's fastest (stride 1, GridGeometry): constant
-      // offsets from the row's first node, no address arithmetic per node.
-      const long n = node + k * (A == Dim - 1 ? 1 : stride[A]);
-      if constexpr (A == Dim - 1) {
-        if constexpr (T.nodal) al.add_scaled(w_before * w, nodal[j * S + k]);
-        Real* out = sums + n * W;
-        R sum = R::load(out);
-        sum += al;
-        sum.store(out);
-      } else {
+    } else {
+      for (int k = 0; k < S; ++k) {
+        const Real w = st.w(A, k);
+        R al = w * alpha;
+        if constexpr (T.moment) al.add_scaled(wd[k][A], gamma[A]);
+        if constexpr (T.gradient) al.add_scaled(st.dw(A, k), beta[A]);
         R g2[Dim], b2[Dim];
         for (int a = A + 1; a < Dim; ++a) {
           if constexpr (T.moment) g2[a] = w * gamma[a];
           if constexpr (T.gradient) b2[a] = w * beta[a];
         }
-        scatter_axis<A + 1, T>(st, wd, last, stride, n, al, g2, b2, nodal, j * S + k, w_before * w,
-                               sums);
+        scatter_axis<A + 1, T>(st, wd, last, stride, node + k * stride[A], al, g2, b2, nodal,
+                               j * S + k, sums);
       }
     }
   }
@@ -352,10 +353,12 @@ class TensorTransfer {
     L Dm[Dim];  // sum_q P(q) with w_a -> w_a d_a, a < Dim - 1
     L Gr[Dim];  // the same with w_a -> dw_a
   };
+  // With T.nodal each row is also copied to nodal (row j at nodal + j S N).
   template <TensorTerms T>
   MPMTB_INLINE static void gather_strips(const St& st, const AxisPack (&wd)[S],
                                          const std::array<long, Dim>& stride,
-                                         const Real* __restrict rows, Partial<T>& out) {
+                                         const Real* __restrict rows, Real* __restrict nodal,
+                                         Partial<T>& out) {
     using GR = typename Partial<T>::GR;
     using L = typename RowSums<T>::L;
     constexpr int B = Dim - 1;  // the last axis
@@ -366,7 +369,7 @@ class TensorTransfer {
       if constexpr (T.gradient) acc.Gr[a] = acc.W;
     }
     Real md[Dim] = {}, gd[Dim] = {};
-    prefix_rows<0, T>(st, wd, stride, st.base_node, rows, Real(1), md, gd, acc);
+    prefix_rows<0, T>(st, wd, stride, st.base_node, 0, rows, nodal, Real(1), md, gd, acc);
     Real w_last[S], wd_last[S], dw_last[S];
     for (int k = 0; k < S; ++k) {
       w_last[k] = st.w(B, k);
@@ -394,16 +397,19 @@ class TensorTransfer {
     return r;
   }
   // Axis A < Dim - 1 of the rows' prefix: w = prod_{b<A} w_b, md[a] (gd[a]) the
-  // same product with w_a d_a (dw_a) for axis a < A.
+  // same product with w_a d_a (dw_a) for axis a < A; j the stencil index of the
+  // axes before A.
   template <int A, TensorTerms T>
   MPMTB_INLINE static void prefix_rows(const St& st, const AxisPack (&wd)[S],
-                                       const std::array<long, Dim>& stride, long node,
-                                       const Real* __restrict rows, Real w, const Real (&md)[Dim],
-                                       const Real (&gd)[Dim], RowSums<T>& acc) {
+                                       const std::array<long, Dim>& stride, long node, int j,
+                                       const Real* __restrict rows, Real* __restrict nodal, Real w,
+                                       const Real (&md)[Dim], const Real (&gd)[Dim],
+                                       RowSums<T>& acc) {
     using L = typename RowSums<T>::L;
     constexpr int N = VR<T>::N;
     if constexpr (A == Dim - 1) {
       const L row = L::load(rows + node * N);
+      if constexpr (T.nodal) row.store(nodal + j * S * N);
       acc.W = L::fma(w, row, acc.W);
       for (int a = 0; a < A; ++a) {
         if constexpr (T.moment) acc.Dm[a] = L::fma(md[a], row, acc.Dm[a]);
@@ -419,45 +425,8 @@ class TensorTransfer {
         }
         if constexpr (T.moment) md2[A] = w * wd[k][A];
         if constexpr (T.gradient) gd2[A] = w * st.dw(A, k);
-        prefix_rows<A + 1, T>(st, wd, stride, node + k * stride[A], rows, w * wk, md2, gd2, acc);
-      }
-    }
-  }
-
-  template <int A, TensorTerms T>
-  MPMTB_INLINE static inline void gather_axis(const St& st, const AxisPack (&wd)[S],
-                                              const std::array<long, Dim>& stride, long node,
-                                              const Real* __restrict rows, Vec<Dim>* nodal, int j,
-                                              Real w_before, Partial<T>& out) {
-    using GR = typename Partial<T>::GR;
-    constexpr int N = VR<T>::N;
-    out.W = GR::zero();
-    for (int a = A; a < Dim; ++a) {
-      if constexpr (T.moment) out.Dm[a] = GR::zero();
-      if constexpr (T.gradient) out.Gr[a] = GR::zero();
-    }
-    for (int k = 0; k < S; ++k) {
-      const Real w = st.w(A, k);
-      const long n = node + k * (A == Dim - 1 ? 1 : stride[A]);  // (as in scatter_axis)
-      if constexpr (A == Dim - 1) {
-        const GR u = GR::load(rows + n * N);
-        if constexpr (T.nodal) {
-          const Real w_ip = w_before * w;
-          for (int a = 0; a < Dim; ++a) nodal[j * S + k][a] = w_ip * rows[n * N + a];
-        }
-        out.W.add_scaled(w, u);
-        if constexpr (T.moment) out.Dm[A].add_scaled(wd[k][A], u);
-        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw(A, k), u);
-      } else {
-        Partial<T> sub;
-        gather_axis<A + 1, T>(st, wd, stride, n, rows, nodal, j * S + k, w_before * w, sub);
-        out.W.add_scaled(w, sub.W);
-        if constexpr (T.moment) out.Dm[A].add_scaled(wd[k][A], sub.W);
-        if constexpr (T.gradient) out.Gr[A].add_scaled(st.dw(A, k), sub.W);
-        for (int a = A + 1; a < Dim; ++a) {
-          if constexpr (T.moment) out.Dm[a].add_scaled(w, sub.Dm[a]);
-          if constexpr (T.gradient) out.Gr[a].add_scaled(w, sub.Gr[a]);
-        }
+        prefix_rows<A + 1, T>(st, wd, stride, node + k * stride[A], j * S + k, rows, nodal, w * wk,
+                              md2, gd2, acc);
       }
     }
   }

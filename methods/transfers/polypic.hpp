@@ -40,19 +40,13 @@ namespace mpmtb {
 template <int Dim, int S>
 struct PolyModes {
   static constexpr int count = ipow(S, Dim);  // modes = stencil nodes
-  // Dim Reals padded to a whole SIMD row (core/pack.hpp): one lane per axis in
-  // build(), one row per node in the transform.
-  static constexpr int kPad = [] {
-    constexpr int lanes = 16 / int(sizeof(Real));  // the narrowest Row
-    return (Dim + lanes - 1) / lanes * lanes;
-  }();
-  using Node = Row<kPad>;
 
-  Real e[Dim][S][S];     // e[a][n][k]: e_n at node k of axis a
-  Real norm[Dim][S];     // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
-  Real unit[Dim][S][S];  // e_n / sqrt(norm) for n >= 1 (0 if dropped), e_0 = 1 (norm 1)
-  Real root_norm[Dim];   // sqrt(norm[a][1]): e_1 = root_norm unit_1
-  Real d0[Dim];          // offset of node 0 per axis
+  Real e[Dim][S][S];      // e[a][n][k]: e_n at node k of axis a
+  Real norm[Dim][S];      // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
+  Real unit[Dim][S][S];   // e_n / sqrt(norm) for n >= 1 (0 if dropped), e_0 = 1 (norm 1)
+  Real wunit[Dim][S][S];  // w_a(k) unit[a][n][k]: the weight folded in (the transforms)
+  Real root_norm[Dim];    // sqrt(norm[a][1]): e_1 = root_norm unit_1
+  Real d0[Dim];           // offset of node 0 per axis
   Real inv_dx;
 
   // Gram-Schmidt of the monomials 1, u, u^2, ... under the weights, twice over
@@ -63,22 +57,18 @@ struct PolyModes {
   // whose norm falls below a relative tolerance of its monomial's is degenerate
   // (fewer weighted nodes than modes, e.g. the linear hat at a node, or the
   // quadratic B-spline half-way between nodes): it and every higher one are dropped.
-  // The axes are independent: each runs in one SIMD lane (padding lanes have
-  // zero weights, so their modes are dropped and never read).
+  // The axes are independent: each runs in one lane of the stencil's AxisPacks
+  // (padding lanes have zero weights, so their modes are dropped and never read).
   template <class Kernel>
   void build(const Stencil<Dim, Kernel>& st, Real dx) {
     static_assert(Kernel::support == S);
-    using Lanes = typename PackOf<kPad * sizeof(Real)>::type;
+    using Lanes = AxisPack;
     inv_dx = 1 / dx;
     const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
-    Lanes u[S], w[S], power[S], q[S][S], norm_n[S], inv_norm[S];
+    Lanes u[S], power[S], q[S][S], norm_n[S], inv_norm[S];
+    const Lanes(&w)[S] = st.wk;
     for (int k = 0; k < S; ++k) {
-      // Set whole, from arrays: lane by lane into a zero pack, GCC reports the
-      // lanes not yet set as maybe uninitialized once the gather is inlined.
-      Real u_k[kPad] = {}, w_k[kPad] = {};
-      for (int a = 0; a < Dim; ++a) u_k[a] = st.d(a, k) * inv_dx, w_k[a] = st.w(a, k);
-      std::memcpy(&u[k], u_k, sizeof(Lanes));
-      std::memcpy(&w[k], w_k, sizeof(Lanes));
+      u[k] = st.dk[k] * inv_dx;
       power[k] = 1 - Lanes{};
     }
     auto dropped = zero < zero;  // all lanes false
@@ -107,7 +97,11 @@ struct PolyModes {
         norm[a][n] = norm_n[n][a];
         // The partition of unity makes e_0 = 1 a unit mode (sum_k w_a(k) = 1).
         const Real inv_root = n == 0 ? Real(1) : std::sqrt(inv_norm[n][a]);
-        for (int k = 0; k < S; ++k) e[a][n][k] = q[n][k][a], unit[a][n][k] = q[n][k][a] * inv_root;
+        for (int k = 0; k < S; ++k) {
+          e[a][n][k] = q[n][k][a];
+          unit[a][n][k] = q[n][k][a] * inv_root;
+          wunit[a][n][k] = st.w(a, k) * unit[a][n][k];
+        }
         if (n == 1) root_norm[a] = norm_n[1][a] * inv_root;  // sqrt(norm), 0 if dropped
       }
       d0[a] = st.d(a, 0);
@@ -123,50 +117,28 @@ struct PolyModes {
     }
     return index;
   }
+  // The unit mode r at the stencil's node j, prod_a unit[a][r_a][j_a] (the
+  // reference evaluation, one product per mode and node).
+  Real unit_mode(int r, int j) const {
+    Real s = 1;
+    for (int a = Dim - 1; a >= 0; --a, r /= S, j /= S) s *= unit[a][r % S][j % S];
+    return s;
+  }
 
-  // The transform in the orthonormal modes s_r / |s_r| (= prod_a unit[a][r_a]),
-  // on one SIMD row per node (Dim Reals, padded: core/pack.hpp), sum-factorised:
-  // Dim passes of S x S, each out[j] = sum_k U_a[j_a][k] in[j with j_a -> k]
-  // (nodal values -> mode sums) or with U_a^T (mode coefficients -> nodal
-  // values), U_a = unit[a]. The index arithmetic is constant once unrolled.
-  template <bool Transpose, int A>
-  MPMTB_INLINE void apply_axis(const Node* __restrict in, Node* __restrict out) const {
-    constexpr int stride = ipow(S, Dim - 1 - A), outer = ipow(S, A);
-    for (int o = 0; o < outer; ++o) {
-      const Node* x = in + o * S * stride;
-      Node* y = out + o * S * stride;
-      for (int n = 0; n < S; ++n) {
-        for (int i = 0; i < stride; ++i) {
-          Node acc = coefficient<Transpose, A>(n, 0) * x[i];
-          for (int k = 1; k < S; ++k)
-            acc.add_scaled(coefficient<Transpose, A>(n, k), x[k * stride + i]);
-          y[n * stride + i] = acc;
-        }
-      }
-    }
+  // The weighted transforms, on one SIMD Row per node or mode (core/pack.hpp):
+  //   to_nodes: out[i] = sum_r c[r] prod_a wunit[a][r_a][i_a] = w_ip sum_r c_r s_r(i)/|s_r|,
+  //             the field with unit-mode coefficients c at the nodes, times w_ip;
+  //   to_modes: out[r] = sum_i prod_a wunit[a][r_a][i_a] v[i] = sum_i w_ip s_r(i) v_i / |s_r|,
+  //             the projection onto the unit modes.
+  // Sum-factorised: Dim passes of S x S, each y[j] = sum_k W_a[j_a][k] x[j with j_a -> k]
+  // with W_a = wunit[a] or its transpose. The index arithmetic is constant once unrolled.
+  template <class Node>
+  MPMTB_INLINE void to_nodes(const Node* c, Node* out) const {
+    transform<true>(c, out);
   }
-  template <bool Transpose, int A>
-  MPMTB_INLINE Real coefficient(int n, int k) const {
-    return Transpose ? unit[A][k][n] : unit[A][n][k];
-  }
-  // From in to out (count values each).
-  template <bool Transpose>
-  void transform(const Vec<Dim>* in, Vec<Dim>* out) const {
-    Node buffer[2][count];
-    for (int j = 0; j < count; ++j) {
-      Real padded[kPad] = {};
-      for (int a = 0; a < Dim; ++a) padded[a] = in[j][a];
-      buffer[0][j] = Node::gather(padded);
-    }
-    [&]<int... A>(std::integer_sequence<int, A...>) {
-      (apply_axis<Transpose, A>(buffer[A % 2], buffer[(A + 1) % 2]), ...);
-    }
-    (std::make_integer_sequence<int, Dim>{});
-    for (int j = 0; j < count; ++j) {
-      Real padded[kPad];
-      buffer[Dim % 2][j].store(padded);
-      for (int a = 0; a < Dim; ++a) out[j][a] = padded[a];
-    }
+  template <class Node>
+  MPMTB_INLINE void to_modes(const Node* v, Node* out) const {
+    transform<false>(v, out);
   }
 
   // Mode r = (r_0, ..., r_{Dim-1}) as a flat index: 0 is the constant, linear(a)
@@ -178,6 +150,37 @@ struct PolyModes {
       if (r == linear(a)) return false;
     return true;
   }
+
+ private:
+  template <bool Transpose, class Node>
+  MPMTB_INLINE void transform(const Node* in, Node* out) const {
+    Node buffer[2][count];
+    [&]<int... A>(std::integer_sequence<int, A...>) MPMTB_INLINE_LAMBDA {
+      (apply_axis<Transpose, A>(A == 0 ? in : buffer[(A + 1) % 2],
+                                A == Dim - 1 ? out : buffer[A % 2]),
+       ...);
+    }
+    (std::make_integer_sequence<int, Dim>{});
+  }
+  template <bool Transpose, int A, class Node>
+  MPMTB_INLINE void apply_axis(const Node* __restrict x, Node* __restrict y) const {
+    constexpr int stride = ipow(S, Dim - 1 - A), outer = ipow(S, A);
+    for (int o = 0; o < outer; ++o) {
+      for (int n = 0; n < S; ++n) {
+        for (int i = 0; i < stride; ++i) {
+          const int first = o * S * stride + i;
+          Node acc = coefficient<Transpose, A>(n, 0) * x[first];
+          for (int k = 1; k < S; ++k)
+            acc.add_scaled(coefficient<Transpose, A>(n, k), x[first + k * stride]);
+          y[first + n * stride] = acc;
+        }
+      }
+    }
+  }
+  template <bool Transpose, int A>
+  MPMTB_INLINE Real coefficient(int n, int k) const {
+    return Transpose ? wunit[A][k][n] : wunit[A][n][k];
+  }
 };
 
 template <int Dim, class Kernel>
@@ -187,6 +190,14 @@ class PolypicPolicy {
   static constexpr int S = Kernel::support;
   using Modes = PolyModes<Dim, S>;
   static constexpr int kModes = Modes::count;
+  // Mode coefficients and nodal momenta in P2G as the rows of the folded sums,
+  // (m, p) padded, with the momentum in the p slots (ScatterForm::nodal); nodal
+  // velocities and mode coefficients in G2P as the packed velocity rows (v, 0).
+  static constexpr int kScatterWidth = kNodalWidth<Dim>;
+  static constexpr int kGatherWidth = VelocityRows<Dim, false>::N;
+  using ScatterRow = Row<kScatterWidth>;
+  using GatherRow = Row<kGatherWidth>;
+  static constexpr int kP = ScatterForm<Dim>::p;
 
  public:
   // The higher-mode coefficients per particle: Dim values per mode.
@@ -198,7 +209,8 @@ class PolypicPolicy {
     Real m;
     M tauV;
     Modes modes;
-    V mv[kModes];  // m_p v_p(x_i) at each stencil node
+    ScatterRow c[kModes];      // m_p times the unit modes' coefficients, in the p slots
+    ScatterRow nodes[kModes];  // w_ip m_p v_p(x_i): ScatterForm::nodal
   };
   // Rebuilds the modes at the particle's current stencil (the orthogonality that
   // conservation needs is under these weights) and evaluates its field at the nodes.
@@ -208,27 +220,37 @@ class PolypicPolicy {
     s.m = P.m[p];
     s.tauV = tauV;
     s.modes.build(st, dx_);
-    V c[kModes];  // the unit modes' coefficients
+    const auto row = [&](const auto& value) MPMTB_INLINE_LAMBDA {
+      RowBuilder<kScatterWidth> r;
+      r.template segment<Dim>(kP) = s.m * value;
+      return r.row();
+    };
     const Real* stored = P.transfer_state_of(p);
     for (int r = 0; r < kModes; ++r) {
       if (Modes::higher(r)) {
-        c[r] = Eigen::Map<const V>(stored);
+        s.c[r] = row(Eigen::Map<const V>(stored));
         stored += Dim;
       }
     }
-    c[0] = P.v[p];
+    s.c[0] = row(P.v[p]);
     // Linear modes in cell units: e_1 = (x_i - x_p)_a / dx, so c = C_p e_a dx,
     // times |e_1| for the unit mode. The higher modes are stored for theirs.
     for (int a = 0; a < Dim; ++a)
-      c[Modes::linear(a)] = P.C[p].col(a) * (dx_ * s.modes.root_norm[a]);
-    s.modes.template transform<true>(c, s.mv);  // coefficients -> nodal velocities
-    for (int j = 0; j < kModes; ++j) s.mv[j] *= s.m;
+      s.c[Modes::linear(a)] = row(P.C[p].col(a) * (dx_ * s.modes.root_norm[a]));
+    s.modes.to_nodes(s.c, s.nodes);
     return s;
   }
+  // The reference: the polynomial evaluated at the node, mode by mode.
   void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
                V& f_i) const {
+    const int j = s.modes.node_index(d);
+    V mv = V::Zero();
+    for (int r = 0; r < kModes; ++r) {
+      const Real sr = s.modes.unit_mode(r, j);
+      for (int a = 0; a < Dim; ++a) mv[a] += sr * lane(s.c[r], kP + a);
+    }
     m_i += w * s.m;
-    p_i += w * s.mv[s.modes.node_index(d)];
+    p_i += w * mv;
     f_i -= s.tauV * grad;
   }
 
@@ -240,26 +262,29 @@ class PolypicPolicy {
     using F_ = ScatterForm<Dim>;
     form.alpha[F_::m] = s.m;
     for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(F_::f) = -s.tauV.col(a);
-    form.nodal = s.mv;
+    form.nodal = rows_data(s.nodes);
   }
 
   struct Gather {
     Modes modes;
     V v = V::Zero();
     M grad_v = M::Zero();
-    V wv[kModes];  // w_ip v_i at each stencil node
+    bool from_rows = false;    // the fast path filled v_rows
+    GatherRow v_rows[kModes];  // v_i at each stencil node (the fast path's, as Reals: v_data)
+    V wv[kModes];              // w_ip v_i at each stencil node (the reference's)
+    Real* v_data() { return rows_data(v_rows); }
   };
   Gather begin_gather(const Stencil<Dim, Kernel>& st) const {
     Gather g;
     g.modes.build(st, dx_);
-    for (auto& x : g.wv) x.setZero();
     return g;
   }
   static constexpr TensorTerms gather_terms{.gradient = true, .nodal = true};
-  // The sums have filled g.wv (core/policy_hooks.hpp: tensor_gather).
+  // The sums have filled g.v_rows (core/policy_hooks.hpp: tensor_gather).
   void gather_from(const GatherSums<Dim>& sums, Gather& g) const {
     g.v = sums.v;
     g.grad_v = sums.G;
+    g.from_rows = true;
   }
   void gather(Gather& g, Real w, const V& grad, const V& d, const V& v_i, const V&) const {
     g.wv[g.modes.node_index(d)] = w * v_i;
@@ -267,11 +292,21 @@ class PolypicPolicy {
     g.grad_v += v_i * grad.transpose();
   }
   void finish(Gather& g, Particles<Dim>& P, int p, Real dt) const {
-    V c[kModes];
     // sum_i w_ip s_r(i) v_i / |s_r| per mode: the coefficient of the unit mode
     // s_r / |s_r| (the projection, as the unit modes are orthonormal), 0 for a
     // dropped one.
-    g.modes.template transform<false>(g.wv, c);
+    V c[kModes];
+    if (g.from_rows) {
+      GatherRow modes[kModes];
+      g.modes.to_modes(g.v_rows, modes);
+      for (int r = 0; r < kModes; ++r)
+        for (int a = 0; a < Dim; ++a) c[r][a] = lane(modes[r], a);
+    } else {  // the reference: mode by mode over the nodes
+      for (int r = 0; r < kModes; ++r) {
+        c[r].setZero();
+        for (int j = 0; j < kModes; ++j) c[r] += g.modes.unit_mode(r, j) * g.wv[j];
+      }
+    }
     Real* stored = P.transfer_state_of(p);
     for (int r = 0; r < kModes; ++r) {
       if (Modes::higher(r)) {
@@ -295,6 +330,21 @@ class PolypicPolicy {
   }
 
  private:
+  // Rows side by side are the Reals of the tensor transfer's rows (Row is its
+  // registers, whole: no padding between rows); written and read with memcpy.
+  template <int N>
+  static Real* rows_data(Row<N>* rows) {
+    static_assert(sizeof(Row<N>) == N * sizeof(Real));
+    return reinterpret_cast<Real*>(rows);
+  }
+  template <int N>
+  static const Real* rows_data(const Row<N>* rows) {
+    return rows_data(const_cast<Row<N>*>(rows));
+  }
+  template <int N>
+  static Real lane(const Row<N>& r, int i) {
+    return r.v[i / Row<N>::lanes][i % Row<N>::lanes];
+  }
   Real dx_;
 };
 
