@@ -156,7 +156,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
       const StencilT st(P.x[p], g.geo);
       // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
       // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
-      typename Policy::Gather gather = [&] {
+      typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
         if constexpr (kTensorPath) {
           return tensor_gather(policy, st, g.geo, rows_.data());
         } else {
