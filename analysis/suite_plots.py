@@ -8,8 +8,10 @@ returns the written PNG paths (empty when the table is absent):
   convergence/<case>_dt.png   the same against dt at a fixed grid
   stability/stability_map.png largest stable CFL per method and case x ppc
   stability/failure_modes.png the failure-mode metrics per method
-  speed_accuracy/<case>_pareto.png  error against wall time and particle-steps,
-                              Pareto front in black
+  speed_accuracy/<case>_work_precision.png  work-precision diagram: error
+                              against time per run and particle-steps, one
+                              panel per kernel, Pareto front in black
+                              (work_precision.py)
   speed_accuracy/throughput.png     particle-steps per second per method
 """
 import glob
@@ -18,6 +20,7 @@ import os
 import numpy as np
 
 import mpmtb_plots as mp
+import work_precision as wp
 
 plt = mp.plt
 
@@ -213,42 +216,6 @@ def plot_failure_modes(suites):
 
 # ------------------------------------------------------- speed-accuracy --
 
-def plot_pareto(path):
-    rows = [r for r in read_rows(path) if r["status"] == "ok"
-            and num(r, "error") > 0 and num(r, "wall_seconds") > 0]
-    if not rows:
-        return []
-    case = os.path.basename(path)[:-4]
-    fig, axes = plt.subplots(1, 2, figsize=(11.0, 4.2), sharey=True)
-    for ax, cost, flag, label in (
-            (axes[0], "wall_seconds", "pareto_time", "wall time [s]"),
-            (axes[1], "particle_steps", "pareto_work", "particle-steps")):
-        for transfer, kernel in methods_of(rows):
-            pts = sorted((num(r, cost), num(r, "error")) for r in rows
-                         if (r["transfer"], r["kernel"]) == (transfer, kernel))
-            x, y = zip(*pts)
-            ax.plot(x, y, marker="o", markersize=3.5,
-                    label=f"{transfer}-{kernel}",
-                    **mp.line_style(transfer, kernel))
-        front = sorted((num(r, cost), num(r, "error")) for r in rows
-                       if r[flag] == "1")
-        if front:
-            x, y = zip(*front)
-            ax.step(x, y, where="post", color="black", linewidth=1.0)
-            ax.scatter(x, y, s=60, facecolors="none", edgecolors="black",
-                       label="Pareto front", zorder=3)
-        ax.set_xscale("log")
-        ax.set_yscale("log")
-        ax.set_xlabel(label)
-        ax.grid(True, which="both", alpha=0.3)
-    axes[0].set_ylabel("error")
-    fig.suptitle(f"speed against accuracy: {case} (one thread per run)")
-    mp.legend_outside(fig, axes[1])
-    out = path[:-4] + "_pareto.png"
-    mp.save_figure(fig, out)
-    return [out]
-
-
 def finest_throughput(rows):
     """{(transfer, kernel): particle-steps/s of the finest ok level}."""
     best = {}
@@ -280,7 +247,8 @@ def plot_throughput(suites, tables):
                       fontsize=8)
         ax.invert_yaxis()
         ax.margins(x=0.2)
-        ax.set_xlabel("particle-steps per second (finest level, 1 thread)")
+        ax.set_xlabel("particle-steps per second (finest level, 1 thread, "
+                      "median of 3, alone)")
         ax.set_title(case, fontsize=9)
         ax.grid(True, axis="x", alpha=0.3)
     fig.tight_layout()
@@ -297,7 +265,7 @@ def plot_speed_accuracy(suites):
     out = []
     tables = speed_tables(suites)
     for path in tables:
-        out += plot_pareto(path)
+        out += wp.plot_work_precision(path)
     out += plot_throughput(suites, tables)
     return out
 

@@ -10,6 +10,7 @@ import numpy as np
 
 import mpmtb_plots as mp
 import suite_plots as sp
+import work_precision as wp
 
 
 def table(head, rows, align=None):
@@ -128,22 +129,43 @@ def speed_section(suites):
                         [{"transfer": t, "kernel": k} for t, k in rates])]
             lines += [f"### Throughput: {case}", "",
                       "Particle-steps per second at the finest level, one "
-                      "thread per run, runs side by side (`--jobs`).", ""]
+                      "thread, each run alone, median of 3 repetitions of at "
+                      "least 0.5 s of stepping.", ""]
             lines += table(["method", "particle-steps/s"], body)
-        front = [r for r in rows if r["pareto_time"] == "1"]
-        front.sort(key=lambda r: sp.num(r, "wall_seconds"))
-        if front:
-            body = [[f"`{r['transfer']}-{r['kernel']}`", r["cells"],
-                     f"{sp.num(r, 'error'):.3g}",
-                     f"{sp.num(r, 'wall_seconds'):.3g}",
-                     "yes" if r["pareto_work"] == "1" else ""] for r in front]
-            lines += [f"### Pareto winners: {case}", "",
-                      "Runs no other run beats in both error and wall time "
-                      "(the last column: also on the front of error against "
-                      "particle-steps). Wall times of short runs are noisy.",
-                      ""]
-            lines += table(["method", "cells", "error", "wall [s]",
-                            "work front"], body)
+        good = wp.usable(rows)
+        if not good:
+            continue
+        key = good[0].get("error_key", "error")
+        front = [r for r in good if r["pareto_time"] == "1"]
+        front.sort(key=lambda r: sp.num(r, "time_s"))
+        body = [[f"`{r['transfer']}-{r['kernel']}`", r["cells"],
+                 f"{sp.num(r, 'error'):.3g}", f"{sp.num(r, 'energy_error'):.2g}",
+                 wp.cost_text(r), f"{sp.num(r, 'cpu_s'):.3g}",
+                 f"{sp.num(r, 'particle_steps'):.3g}",
+                 "yes" if r["pareto_work"] == "1" else ""] for r in front]
+        lines += [f"### Pareto front: {case}", "",
+                  f"Error `error.{key}` against the time of one run (median "
+                  "of 3 repetitions timed alone, min-max in brackets): the "
+                  "runs no other run beats in both. Energy error, CPU time "
+                  "and particle-steps beside them; the last column: also on "
+                  "the front of error against particle-steps. Figure: "
+                  f"`suites/speed_accuracy/{case}_work_precision.png`.", ""]
+        lines += table(["method", "cells", "error", "energy error",
+                        "time per run [s]", "CPU [s]", "particle-steps",
+                        "work front"], body)
+        if any(r.get("pareto_period") == "1" for r in good):
+            lines += ["", "What the period error alone would call the front "
+                      "(`error.period_rel` against the same times): "
+                      + wp.front_text(good, "pareto_period") + ".",
+                      "", "The front of the field error: "
+                      + wp.front_text(good, "pareto_time") + "."]
+        lines += ["", f"### Cheapest method for a tolerance: {case}", "",
+                  f"For each tolerance on `error.{key}`, the cheapest method "
+                  "(transfer-kernel, its cheapest grid) that reaches it, and "
+                  "the next two; cost: median time per run (min-max).", ""]
+        lines += table(["tolerance", "cheapest", "second", "third"],
+                       wp.cheapest_table(good))
+        lines += [""]
     return lines
 
 

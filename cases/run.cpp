@@ -335,6 +335,8 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
     j["error"] = reference->errors();
     j["measured"] = reference->measured();
   }
+  if (options.timing.repeats > 0 && status == "ok")
+    j["timing"] = time_stepping(scene, options.timing);
 
   write_atomically(out_dir / "summary.json", dump_json(j));
   // A finished run needs no restart point (an unstable one would only repeat its failure).

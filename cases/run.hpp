@@ -8,6 +8,7 @@
 #include <string>
 
 #include "scene.hpp"
+#include "timing.hpp"
 #include "vtk/frame_options.hpp"
 
 namespace mpmtb {
@@ -26,6 +27,8 @@ struct RunOptions {
   // A checkpoint to continue (its meta record already read): the run goes on
   // from its state into the same folder.
   ArchiveReader* resume = nullptr;
+  // After a stable run, time its stepping again (summary `timing`; timing.hpp).
+  TimingOptions timing = {};
 };
 
 struct RunOutcome {

@@ -12,7 +12,8 @@ rm -rf "$work" && mkdir -p "$work/bar"
   --transfer pic --quiet --out "$work/suites"
 "$mpmtb" suite stability --case bar_fixed --case translate --transfer mls --kernel linear \
   --kernel cubic --quiet --out "$work/suites"
-"$mpmtb" suite speed-accuracy --transfer apic --kernel quadratic --quiet --out "$work/suites"
+"$mpmtb" suite speed-accuracy --case bar_2d --transfer apic --transfer pic --kernel quadratic \
+  --quiet --out "$work/suites"
 /usr/bin/python3 "$source_dir/analysis/plot_all.py" --results "$work"
 test -s "$work/README.md"
 figures=$(grep -o '([^)]*\.png)' "$work/README.md" | tr -d '()')
@@ -22,11 +23,24 @@ for f in $figures; do
 done
 for f in suites/convergence/bar.png suites/convergence/bar_dt.png \
   suites/stability/stability_map.png suites/stability/failure_modes.png \
-  suites/speed_accuracy/bar_2d_pareto.png suites/speed_accuracy/throughput.png; do
+  suites/speed_accuracy/bar_2d_work_precision.png suites/speed_accuracy/throughput.png; do
   grep -q "($f)" "$work/README.md" || { echo "$f missing from the index"; exit 1; }
 done
 grep -q "### Observed orders" "$work/README.md" || { echo "no orders table"; exit 1; }
 grep -q "### Largest stable CFL" "$work/README.md" || { echo "no stability table"; exit 1; }
+grep -q "### Cheapest method for a tolerance: bar_2d" "$work/README.md" ||
+  { echo "no cheapest-method table"; exit 1; }
+# The work-precision table: every point timed (median of 3 with its spread).
+/usr/bin/python3 - "$work/suites/speed_accuracy/bar_2d.csv" <<'PY'
+import csv, sys
+rows = list(csv.DictReader(open(sys.argv[1])))
+assert rows, "empty work-precision table"
+for r in rows:
+    assert r["status"] == "ok", r
+    lo, med, hi = float(r["time_min_s"]), float(r["time_s"]), float(r["time_max_s"])
+    assert 0 < lo <= med <= hi, r
+    assert int(r["repeats"]) >= 3 and int(r["passes"]) >= 1, r
+PY
 for run in $("$mpmtb" list transfers); do
   grep -q "$run-linear" "$work/README.md" || { echo "$run-linear missing from the index"; exit 1; }
 done

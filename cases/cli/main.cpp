@@ -207,6 +207,16 @@ int main(int argc, char** argv) {
       "continue the stopped run in DIR from DIR/checkpoint/ with its own scene, options and "
       "thread count; the result equals an uninterrupted run byte for byte");
   resume_opt->excludes(scene_opt)->excludes(config_opt);
+  run->add_option("--timing-repeats", run_request.options.timing.repeats,
+                  "after a stable run, time its stepping N more times on a fresh state, each "
+                  "repetition repeating the run until it has stepped --timing-min-seconds; "
+                  "summary `timing`: seconds per run (wall, CPU) median/min/max (0: off)")
+      ->check(CLI::Range(0, 1000))
+      ->capture_default_str();
+  run->add_option("--timing-min-seconds", run_request.options.timing.min_seconds,
+                  "stepping time of each timing repetition, at least")
+      ->check(CLI::Range(0.0, 3600.0))
+      ->capture_default_str();
   run->add_option("--max-memory", run_request.max_memory,
                   "memory the run may use, e.g. 64G or 512M (default: the machine's "
                   "MemAvailable); larger estimates are refused before anything is allocated");

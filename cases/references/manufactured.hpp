@@ -38,6 +38,8 @@ struct AxisAlignedSolution {
   Mat<Dim> deformation_rate(const Vec<Dim>& X, Real t) const;  // dF/dt
   // Body force per unit mass b(X, t) for the neo-Hookean solid.
   Vec<Dim> body_force(const Vec<Dim>& X, Real t) const;
+  // Neo-Hookean strain energy density psi(F(X, t)) per reference volume.
+  Real strain_energy_density(const Vec<Dim>& X, Real t) const;
 };
 
 template <int Dim>
@@ -48,11 +50,15 @@ class ManufacturedReference final : public Reference<Dim> {
   ManufacturedReference(const Scene& scene, const std::string& kind);
 
   void initialize(State<Dim>& s) override;
-  std::vector<std::string> columns() const override { return {"disp_l2", "disp_linf"}; }
+  std::vector<std::string> columns() const override {
+    return {"disp_l2", "disp_linf", "energy_err"};
+  }
   std::vector<Real> sample(const State<Dim>& s, const Diagnostics& d) override;
   nlohmann::json errors() const override;
   nlohmann::json measured() const override;
-  std::vector<Real> saved() const override { return {max_l2_, max_linf_}; }
+  std::vector<Real> saved() const override {
+    return {max_l2_, max_linf_, max_energy_error_, max_energy_};
+  }
   void restore(const std::vector<Real>& v) override;
 
   const AxisAlignedSolution<Dim>& solution() const { return exact_; }
@@ -66,6 +72,8 @@ class ManufacturedReference final : public Reference<Dim> {
   bool half_step_start_ = true;
   Real cfl_ = 0, dt_ = 0, t_end_ = 0;  // the scene's time stepping
   Real max_l2_ = 0, max_linf_ = 0;
+  // max over output times of |E_h - E(t)| and of E(t), E = kinetic + strain.
+  Real max_energy_error_ = 0, max_energy_ = 0;
 };
 
 }  // namespace mpmtb

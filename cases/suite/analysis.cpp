@@ -69,8 +69,13 @@ std::vector<bool> pareto_front(const std::vector<double>& cost, const std::vecto
     bool dominated = false;
     for (std::size_t j = 0; j < n && !dominated; ++j) {
       if (j == i || !std::isfinite(cost[j]) || !std::isfinite(error[j])) continue;
-      dominated =
-          cost[j] <= cost[i] && error[j] <= error[i] && (cost[j] < cost[i] || error[j] < error[i]);
+      // Errors within kErrorTie of each other are one error: the same scheme
+      // reached by two routes (MLS-MPM and APIC with the hat, PolyPIC's linear
+      // modes) differs by round-off, and the slower of the two is not on the front.
+      const double tie = kErrorTie * std::max(std::abs(error[i]), std::abs(error[j]));
+      const bool no_worse = error[j] <= error[i] + tie;
+      const bool better = error[j] < error[i] - tie;
+      dominated = cost[j] <= cost[i] && no_worse && (cost[j] < cost[i] || better);
     }
     front[i] = !dominated;
   }

@@ -32,7 +32,9 @@ OrderFit fit_order(const std::vector<double>& h, const std::vector<double>& e);
 double log_slope(const std::vector<double>& x, const std::vector<double>& y);
 
 // true for the points no other point beats in both cost and error (lower is
-// better in each; NaN points are never on the front).
+// better in each; NaN points are never on the front). Errors within a relative
+// kErrorTie of each other count as equal (round-off of one scheme reached two ways).
+inline constexpr double kErrorTie = 1e-9;
 std::vector<bool> pareto_front(const std::vector<double>& cost, const std::vector<double>& error);
 
 // For values sorted ascending with a stable flag each: the largest value below

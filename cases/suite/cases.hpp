@@ -28,6 +28,9 @@ struct ConvergenceCase {
   // Time-step study at a fixed grid: cells (0: none) and the coarsest CFL.
   int dt_cells_quick = 0, dt_cells_full = 0;
   double dt_cfl = 0.5;
+  // Speed-accuracy: the methods of the quick level (empty: every one); --full
+  // runs every registered transfer x kernel.
+  std::vector<std::string> quick_transfers = {}, quick_kernels = {};
 };
 
 // Stability: a grid of CFL values for each particles-per-cell count.

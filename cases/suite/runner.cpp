@@ -88,15 +88,15 @@ std::string clock_text(double seconds) {
 // otherwise, nothing when quiet.
 class Progress {
  public:
-  Progress(const RunnerOptions& o, int total, int before)
+  Progress(const RunnerOptions& o, int total, int before, bool timed = false)
       : quiet_(o.quiet),
         tty_(::isatty(STDERR_FILENO)),
         title_(o.title),
         total_(total),
         before_(before) {
     if (quiet_) return;
-    fmt::print(stderr, "{}: {} runs: {} finished before, {} to run ({} at once)\n", title_, total,
-               before, total - before, o.jobs);
+    fmt::print(stderr, "{}: {} runs: {} finished before, {} to run ({})\n", title_, total, before,
+               total - before, timed ? "timed: one at a time" : fmt::format("{} at once", o.jobs));
   }
   void update(int ran, bool force = false) {
     if (quiet_) return;
@@ -280,6 +280,10 @@ std::vector<std::string> RunSpec::arguments(const fs::path& out) const {
   if (dt) a.insert(a.end(), {"--dt", number(*dt)});
   if (t_end) a.insert(a.end(), {"--t-end", number(*t_end)});
   for (const auto& s : sets) a.insert(a.end(), {"--set", s});
+  if (timing_repeats > 0) {
+    a.insert(a.end(), {"--timing-repeats", std::to_string(timing_repeats), "--timing-min-seconds",
+                       number(timing_min_seconds)});
+  }
   a.insert(a.end(), {"--threads", "1", "--out", out.string()});
   return a;
 }
@@ -295,10 +299,15 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
       pending.push_back(i);
     }
   }
+  // The runs that may share the cores first, then the timed ones, one at a time.
+  std::stable_partition(pending.begin(), pending.end(),
+                        [&](std::size_t i) { return !specs[i].serial(); });
   const int total = static_cast<int>(specs.size());
   const int before = total - static_cast<int>(pending.size());
   if (stats) *stats = {total, before, 0};
-  Progress progress(options, total, before);
+  const bool timed =
+      std::any_of(pending.begin(), pending.end(), [&](std::size_t i) { return specs[i].serial(); });
+  Progress progress(options, total, before, timed);
   if (pending.empty()) return results;
 
   std::string exe = options.executable;
@@ -316,6 +325,10 @@ std::vector<RunResult> run_all(const std::vector<RunSpec>& specs, const fs::path
     }
     while (!pending.empty() && static_cast<int>(running.size()) < jobs) {
       const std::size_t i = pending.front();
+      // A timed run starts alone, and nothing starts beside it.
+      const bool alone = std::any_of(running.begin(), running.end(),
+                                     [&](const auto& r) { return specs[r.second.index].serial(); });
+      if (alone || (specs[i].serial() && !running.empty())) break;
       pending.pop_front();
       const pid_t pid = launch(exe, specs[i], root / specs[i].dir);
       running[pid] = {i, Clock::now()};

@@ -32,6 +32,12 @@ struct RunSpec {
   nlohmann::json tags = nlohmann::json::object();
   // Estimated work (suite::CostModel), only to balance shards.
   double cost = 1;
+  // Timed: --timing-repeats N (timing.hpp), and run alone: nothing else of the
+  // suite runs beside it, whatever --jobs says, so that runs do not time each
+  // other's contention for the cores.
+  int timing_repeats = 0;
+  double timing_min_seconds = 0.5;
+  bool serial() const { return timing_repeats > 0; }
 
   std::vector<std::string> arguments(const std::filesystem::path& out) const;
 };

@@ -136,9 +136,25 @@ RunSpec make_spec(const std::string& case_name, const std::string& scene, int di
   return s;
 }
 
-// The grid study (and the time-step study when asked) of every method on a case.
+// The methods of a speed-accuracy case: at the quick level its own subset.
+std::vector<Method> timed_methods(const SuiteRequest& r, const suite::ConvergenceCase& c) {
+  std::vector<Method> m;
+  for (const Method& x : methods(r)) {
+    if (r.full || (wanted(c.quick_transfers, x.transfer) && wanted(c.quick_kernels, x.kernel))) {
+      m.push_back(x);
+    }
+  }
+  return m;
+}
+
+// Timed runs of the speed-accuracy suite: repetitions and the stepping time of each.
+constexpr int kTimingRepeats = 3;
+constexpr double kTimingMinSeconds = 0.5;
+
+// The grid study (and the time-step study when asked) of every method on a case;
+// `timed`: every run also times its stepping, alone (speed-accuracy).
 void plan_refinement(const SuiteRequest& r, const suite::ConvergenceCase& c, bool dt_study,
-                     std::vector<RunSpec>& specs, std::vector<Series>& series) {
+                     bool timed, std::vector<RunSpec>& specs, std::vector<Series>& series) {
   const suite::Levels levels = r.full ? c.full : c.quick;
   const double t_end = r.full ? c.t_end_full : c.t_end_quick;
   const int dt_cells = dt_study ? (r.full ? c.dt_cells_full : c.dt_cells_quick) : 0;
@@ -149,12 +165,16 @@ void plan_refinement(const SuiteRequest& r, const suite::ConvergenceCase& c, boo
     const Scene s = load_scene(c.scene, overrides_for(c.scene, c.dim, dt_cells, c.sets));
     dt0 = c.dt_cfl * s.dx() / max_wave_speed(s);
   }
-  for (const Method& m : methods(r)) {
+  for (const Method& m : timed ? timed_methods(r, c) : methods(r)) {
     Series g{c.name, "grid", c.error_key, m, {}, {}, {}};
     const auto cells = levels.cells();
     for (std::size_t k = 0; k < cells.size(); ++k) {
       RunSpec s = make_spec(c.name, c.scene, c.dim, m, cells[k], t_end, c.sets);
       s.cfl = c.cfl;
+      if (timed) {
+        s.timing_repeats = kTimingRepeats;
+        s.timing_min_seconds = kTimingMinSeconds;
+      }
       s.dir = fs::path("runs") / c.name / m.name() / fmt::format("L{}", k);
       s.cost = model.cost(s);
       g.runs.push_back(specs.size());
@@ -227,7 +247,7 @@ Plan plan_convergence(const SuiteRequest& r) {
   Plan p{"convergence", fs::path(r.out) / "convergence", {}, {}};
   std::vector<Series> series;
   for (const auto& c : suite::convergence_cases()) {
-    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, true, p.specs, series);
+    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, true, false, p.specs, series);
   }
   p.write_tables = [root = p.root, series = std::move(series)](const auto& results) {
     write_convergence_tables(root, series, results);
@@ -404,40 +424,94 @@ Plan plan_stability(const SuiteRequest& r) {
 
 // ------------------------------------------------------- speed-accuracy --
 
-// The Pareto tables: error against wall time and against particle-steps.
+// A statistic of the summary's `timing` (timing.hpp): timing.<group>.<stat>.
+double timing_of(const RunResult& r, const char* group, const char* stat) {
+  if (r.status != "ok" || !r.summary.contains("timing")) return kNaN;
+  const json& t = r.summary["timing"];
+  return t.contains(group) ? number_of(t[group], stat) : kNaN;
+}
+
+// The fewest passes of a timed run's repetitions (how often the run was repeated
+// to reach the minimum stepping time).
+std::string fewest_passes(const RunResult& r) {
+  if (r.status != "ok" || !r.summary.contains("timing")) return "";
+  long fewest = -1;
+  for (const json& rep : r.summary["timing"].value("repetitions", json::array())) {
+    const long n = rep.value("passes", 0L);
+    fewest = fewest < 0 ? n : std::min(fewest, n);
+  }
+  return fewest < 0 ? "" : std::to_string(fewest);
+}
+
+// The work-precision tables: the error of each run against its cost, the
+// median time of one run (min and max of the repetitions beside it), its CPU
+// time and its particle-steps, with the Pareto fronts of error against time
+// (`pareto_time`), against particle-steps (`pareto_work`) and, where the case
+// has a period error (the bar), of the period error against time
+// (`pareto_period`: the front a period-only metric would draw).
 void write_speed_tables(const fs::path& root, const std::vector<Series>& series,
                         const std::vector<RunResult>& results) {
   std::map<std::string, std::vector<const Series*>> by_case;
   for (const auto& g : series) by_case[g.case_name].push_back(&g);
   for (const auto& [name, groups] : by_case) {
-    std::vector<double> wall, work, err;
+    std::vector<double> time, work, err, period;
     std::vector<std::pair<const Series*, std::size_t>> rows;
     for (const Series* g : groups) {
       for (std::size_t k = 0; k < g->runs.size(); ++k) {
         const RunResult& res = results[g->runs[k]];
-        const double e = error_of(res, g->error_key);
         const double ok = res.status == "ok" ? 1.0 : kNaN;
-        wall.push_back(ok * number_of(res.summary, "wall_seconds"));
+        time.push_back(timing_of(res, "seconds_per_pass", "median"));
         work.push_back(ok * number_of(res.summary, "particles") * number_of(res.summary, "steps"));
-        err.push_back(e);
+        err.push_back(error_of(res, g->error_key));
+        period.push_back(error_of(res, "period_rel"));
         rows.emplace_back(g, k);
       }
     }
-    const auto front_time = suite::pareto_front(wall, err);
+    const auto front_time = suite::pareto_front(time, err);
     const auto front_work = suite::pareto_front(work, err);
-    Table t{{"case", "transfer", "kernel", "level", "cells", "h", "particles", "steps",
-             "particle_steps", "wall_seconds", "step_seconds", "particle_steps_per_second",
-             "status", "error", "pareto_time", "pareto_work"},
+    const auto front_period = suite::pareto_front(time, period);
+    Table t{{"case",         "transfer",     "kernel",
+             "level",        "cells",        "h",
+             "particles",    "steps",        "particle_steps",
+             "time_s",       "time_min_s",   "time_max_s",
+             "cpu_s",        "cpu_min_s",    "cpu_max_s",
+             "repeats",      "passes",       "particle_steps_per_second",
+             "wall_seconds", "status",       "error_key",
+             "error",        "energy_error", "period_error",
+             "pareto_time",  "pareto_work",  "pareto_period"},
             {}};
     for (std::size_t i = 0; i < rows.size(); ++i) {
       const auto& [g, k] = rows[i];
       const RunResult& res = results[g->runs[k]];
       const json& s = res.summary;
-      t.rows.push_back(
-          {name, g->method.transfer, g->method.kernel, std::to_string(k), int_text(s, "cells"),
-           num(g->h[k]), int_text(s, "particles"), int_text(s, "steps"), num(work[i]), num(wall[i]),
-           num(number_of(s, "step_seconds")), num(number_of(s, "particle_steps_per_second")),
-           res.status, num(err[i]), front_time[i] ? "1" : "0", front_work[i] ? "1" : "0"});
+      const bool timed = res.status == "ok" && s.contains("timing");
+      t.rows.push_back({name,
+                        g->method.transfer,
+                        g->method.kernel,
+                        std::to_string(k),
+                        int_text(s, "cells"),
+                        num(g->h[k]),
+                        int_text(s, "particles"),
+                        int_text(s, "steps"),
+                        num(work[i]),
+                        num(time[i]),
+                        num(timing_of(res, "seconds_per_pass", "min")),
+                        num(timing_of(res, "seconds_per_pass", "max")),
+                        num(timing_of(res, "cpu_seconds_per_pass", "median")),
+                        num(timing_of(res, "cpu_seconds_per_pass", "min")),
+                        num(timing_of(res, "cpu_seconds_per_pass", "max")),
+                        timed ? int_text(s["timing"], "repeats") : "",
+                        fewest_passes(res),
+                        num(timing_of(res, "particle_steps_per_second", "median")),
+                        num(number_of(s, "wall_seconds")),
+                        res.status,
+                        g->error_key,
+                        num(err[i]),
+                        num(error_of(res, "energy_rel")),
+                        num(period[i]),
+                        front_time[i] ? "1" : "0",
+                        front_work[i] ? "1" : "0",
+                        front_period[i] ? "1" : "0"});
     }
     t.write(root / (name + ".csv"));
   }
@@ -447,7 +521,7 @@ Plan plan_speed_accuracy(const SuiteRequest& r) {
   Plan p{"speed-accuracy", fs::path(r.out) / "speed_accuracy", {}, {}};
   std::vector<Series> series;
   for (const auto& c : suite::speed_accuracy_cases()) {
-    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, false, p.specs, series);
+    if (runnable(r, c.name, c.scene)) plan_refinement(r, c, false, true, p.specs, series);
   }
   p.write_tables = [root = p.root, series = std::move(series)](const auto& results) {
     write_speed_tables(root, series, results);

@@ -82,6 +82,17 @@ TEST(SuitePareto, FrontIsTheNonDominatedSet) {
   EXPECT_FALSE(f[5]);  // no cost: not a point
 }
 
+TEST(SuitePareto, ErrorsEqualToRoundOffAreOneError) {
+  // The same scheme two ways (MLS-MPM = APIC with the hat): the slower of two
+  // runs whose errors differ by round-off is dominated, whichever is smaller.
+  const std::vector<double> cost = {1, 2, 3};
+  const std::vector<double> err = {0.5, 0.5 * (1 - 1e-13), 0.5 * (1 - 1e-6)};
+  const auto f = pareto_front(cost, err);
+  EXPECT_TRUE(f[0]);
+  EXPECT_FALSE(f[1]);
+  EXPECT_TRUE(f[2]);  // a real improvement, however small, counts
+}
+
 TEST(SuiteStability, LargestStableStopsAtTheFirstFailure) {
   const std::vector<double> cfl = {0.5, 1.0, 1.5, 2.0};
   auto r = largest_stable(cfl, {true, true, false, true});
