@@ -210,15 +210,7 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
     return A * sigma * A;
   }
   Real max_driving_stress(const Mat<Dim>& F, const Real* q) const {
-    const Mat<Dim> s = driving_stress(F, q);
-    if constexpr (Dim == 1) {
-      return s(0, 0);
-    } else {
-      const Mat<Dim> sym = Real(0.5) * (s + s.transpose());
-      return Eigen::SelfAdjointEigenSolver<Mat<Dim>>(sym, Eigen::EigenvaluesOnly)
-          .eigenvalues()
-          .maxCoeff();
-    }
+    return Matrix::max_symmetric_eigenvalue(driving_stress(F, q));
   }
 
   // Writes the current fibres a_f = F a0_f / |F a0_f|, then updates the damage at
@@ -273,19 +265,7 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
   }
   // largest eig(sigma~) - sigma_crit, with the Gershgorin shortcut of models/damage.hpp.
   Real stress_excess(const Mat<Dim>& F, const Real* q) const {
-    if constexpr (Dim >= 2) {
-      const Mat<Dim> s = driving_stress(F, q);
-      Real bound = -std::numeric_limits<Real>::infinity();
-      for (int i = 0; i < Dim; ++i) {
-        Real row = s(i, i);
-        for (int j = 0; j < Dim; ++j) {
-          if (j != i) row += Real(0.5) * std::abs(s(i, j) + s(j, i));
-        }
-        bound = std::max(bound, row);
-      }
-      if (bound < m_.sigma_crit() * (1 - Real(1e-9))) return bound - m_.sigma_crit();
-    }
-    return max_driving_stress(F, q) - m_.sigma_crit();
+    return Matrix::eigenvalue_excess(driving_stress(F, q), m_.sigma_crit());
   }
 
   Matrix m_;

@@ -157,36 +157,42 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   // Undamaged Cauchy stress sigma = tau(F, d = 0) / J: the damage driver.
   Mat<Dim> undamaged_cauchy(const Mat<Dim>& F) const { return tau_with(F, 1) / F.determinant(); }
   Real max_principal_stress(const Mat<Dim>& F) const {
-    const Mat<Dim> sigma = undamaged_cauchy(F);
+    return max_symmetric_eigenvalue(undamaged_cauchy(F));
+  }
+  // sigma_max - sigma_crit, or a negative number when a cheap bound shows that
+  // sigma_max stays below sigma_crit (most particles, most steps).
+  Real stress_excess(const Mat<Dim>& F) const {
+    return eigenvalue_excess(undamaged_cauchy(F), sigma_crit_);
+  }
+  // The largest eigenvalue of the symmetric part of s.
+  static Real max_symmetric_eigenvalue(const Mat<Dim>& s) {
     if constexpr (Dim == 1) {
-      return sigma(0, 0);
+      return s(0, 0);
     } else {
-      const Mat<Dim> sym = Real(0.5) * (sigma + sigma.transpose());
+      const Mat<Dim> sym = Real(0.5) * (s + s.transpose());
       Eigen::SelfAdjointEigenSolver<Mat<Dim>> eig(sym, Eigen::EigenvaluesOnly);
       return eig.eigenvalues().maxCoeff();
     }
   }
-
-  // sigma_max - sigma_crit, or a negative number when a cheap bound shows that
-  // sigma_max stays below sigma_crit (most particles, most steps): then the
-  // eigenvalue solve is skipped. The bound is Gershgorin's: every eigenvalue of
-  // a symmetric matrix A is at most max_i (A_ii + sum_{j != i} |A_ij|). The
-  // margin keeps the answer the same as the solver's for stresses within
-  // round-off of sigma_crit.
-  Real stress_excess(const Mat<Dim>& F) const {
+  // max_symmetric_eigenvalue(s) - limit, or a negative number when a cheap bound
+  // shows that it stays below the limit: then the eigenvalue solve is skipped.
+  // The bound is Gershgorin's: every eigenvalue of a symmetric matrix A is at most
+  // max_i (A_ii + sum_{j != i} |A_ij|). The margin keeps the answer the same as
+  // the solver's for stresses within round-off of the limit. Shared with
+  // aniso-damage, which drives the damage with its weighted stress.
+  static Real eigenvalue_excess(const Mat<Dim>& s, Real limit) {
     if constexpr (Dim >= 2) {
-      const Mat<Dim> sigma = undamaged_cauchy(F);
       Real bound = -std::numeric_limits<Real>::infinity();
       for (int i = 0; i < Dim; ++i) {
-        Real row = sigma(i, i);
+        Real row = s(i, i);
         for (int j = 0; j < Dim; ++j) {
-          if (j != i) row += Real(0.5) * std::abs(sigma(i, j) + sigma(j, i));
+          if (j != i) row += Real(0.5) * std::abs(s(i, j) + s(j, i));
         }
         bound = std::max(bound, row);
       }
-      if (bound < sigma_crit_ * (1 - Real(1e-9))) return bound - sigma_crit_;
+      if (bound < limit * (1 - Real(1e-9))) return bound - limit;
     }
-    return max_principal_stress(F) - sigma_crit_;
+    return max_symmetric_eigenvalue(s) - limit;
   }
 
   // Damage update at fixed F (lap d, when l0 > 0, from the step); F is not changed.
