@@ -10,9 +10,14 @@
 //   Gather gather_from(sums)                     or, with TensorTerms::nodal,
 //   void gather_from(sums, Gather&)              after the stencil's velocity rows
 //                                                were copied to Gather::v_data().
+//   void finish_rows(rows, stencil, P, p, dt)    G2P's finish straight from the
+//                                                stencil sums in registers
+//                                                (TensorTransfer::Partial), declared
+//                                                with `using FinishRows = ThisPolicy;`.
 #pragma once
 
 #include <concepts>
+#include <type_traits>
 
 #include "core/particles.hpp"
 #include "core/stencil.hpp"
@@ -62,6 +67,16 @@ MPMTB_INLINE inline typename Policy::Gather tensor_gather(const Policy& policy,
     return gather;
   } else {
     return policy.gather_from(Sums::template gather<terms>(st, g, rows));
+  }
+}
+
+// True when Policy itself (not only a base class) finishes from the rows.
+template <class Policy>
+constexpr bool has_finish_rows() {
+  if constexpr (requires { typename Policy::FinishRows; }) {
+    return std::is_same_v<typename Policy::FinishRows, Policy>;
+  } else {
+    return false;
   }
 }
 

@@ -51,6 +51,8 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   }();
   // A policy that declares old_velocity_series() has the grid update replace
   // v_old by a polynomial in the particle projection (filter_old_velocity; XPIC).
+  // A tensor-path policy that finishes G2P from the stencil sums in registers.
+  static constexpr bool kFinishRows = kTensorPath && has_finish_rows<Policy>();
   static constexpr bool kFiltersOldVelocity = requires(const Policy& q) {
     q.old_velocity_series();
   };
@@ -154,26 +156,38 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
               : J_max, v2_max) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       const StencilT st(P.x[p], g.geo);
-      // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
-      // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
-      typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
-        if constexpr (kTensorPath) {
-          return tensor_gather(policy, st, g.geo, rows_.data());
+      // kDeform = false: the finish may update F, the motion part keeps it.
+      const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
+        if constexpr (kDeform) {
+          finish_particle();
         } else {
-          return begin_gather(policy, st);
+          const Mat<Dim> F = P.F[p];
+          finish_particle();
+          P.F[p] = F;
         }
-      }();
-      if constexpr (!kTensorPath) {
-        st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
-          policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
+      };
+      if constexpr (kFinishRows) {
+        const auto sums = TensorTransfer<Dim, Kernel>::template gather_rows<Policy::gather_terms>(
+            st, g.geo, rows_.data());
+        finish([&]() MPMTB_INLINE_LAMBDA {
+          policy.finish_rows(sums, st, P, static_cast<int>(p), dt);
         });
-      }
-      if constexpr (kDeform) {
-        policy.finish(gather, P, static_cast<int>(p), dt);
       } else {
-        const Mat<Dim> F = P.F[p];
-        policy.finish(gather, P, static_cast<int>(p), dt);
-        P.F[p] = F;
+        // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
+        // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
+        typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
+          if constexpr (kTensorPath) {
+            return tensor_gather(policy, st, g.geo, rows_.data());
+          } else {
+            return begin_gather(policy, st);
+          }
+        }();
+        if constexpr (!kTensorPath) {
+          st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
+            policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
+          });
+        }
+        finish([&]() MPMTB_INLINE_LAMBDA { policy.finish(gather, P, static_cast<int>(p), dt); });
       }
       // Failure detection, fused into this loop so that it costs nothing extra:
       // the squared speed (one square root per step, below), and the box test

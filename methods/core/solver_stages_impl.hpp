@@ -7,6 +7,7 @@
 #include <cmath>
 #include <limits>
 
+#include "core/deformation.hpp"
 #include "core/solver_stages.hpp"
 #include "kernels/all.hpp"
 
@@ -137,7 +138,7 @@ StepReport SolverStages<Dim, Kernel, kFold>::update_deformation(State<Dim>& s, R
     const StencilT st(P.x[p], g.geo);
     const Mat<Dim> G =
         Sums::template gather<TensorTerms{.gradient = true}>(st, g.geo, v_rows_.data()).G;
-    P.F[p] = (Mat<Dim>::Identity() + dt * G) * P.F[p];
+    deformation_update<Dim>(P.F[p], G, dt);
     const Real J = P.F[p].determinant();
     J_min = std::min(J_min, J);
     J_max = std::max(J_max, J);

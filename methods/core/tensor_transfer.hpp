@@ -187,6 +187,31 @@ class TensorTransfer {
     scatter_rows<T>(st, g, fold(form.alpha, dt), gamma, beta, form.nodal, sums);
   }
 
+  // The stencil sums as they leave the loop, in registers: W = sum w v_i (and
+  // v_i_old in the slots after VelocityRows::old), Dm[a] = sum w v_i (x_i - x_p)_a
+  // and Gr[a] = sum v_i (grad w)_a, each a row of VelocityRows<Dim, T.old>::N
+  // values with v_i's components in its first lanes. A policy may finish from
+  // these directly (finish_rows, core/policy_hooks.hpp): converted to GatherSums'
+  // Eigen matrices they went through the stack in scalars and came back in
+  // packets, which stalled G2P on store forwarding.
+  template <TensorTerms T>
+  struct Partial {
+    static constexpr TensorTerms terms = T;
+    using GR = Row<VelocityRows<Dim, T.old>::N>;
+    GR W;
+    GR Dm[Dim], Gr[Dim];
+  };
+  template <TensorTerms T>
+  MPMTB_INLINE static Partial<T> gather_rows(const St& st, const GridGeometry<Dim>& g,
+                                             const Real* __restrict rows,
+                                             Real* __restrict nodal = nullptr) {
+    AxisPack wd[S];  // w_a d_a of node k, axis a in lane a (as Stencil's factors)
+    for (int k = 0; k < S; ++k) wd[k] = st.wk[k] * st.dk[k];
+    Partial<T> part;
+    gather_strips<T>(st, wd, g.strides(), rows, nodal, part);
+    return part;
+  }
+
   // The sums from the packed velocities (VelocityRows<Dim, T.old>::data()); with
   // T.nodal also the stencil's rows themselves, copied to nodal (St::count rows of
   // VelocityRows::N values, last axis fastest).
@@ -194,10 +219,7 @@ class TensorTransfer {
   MPMTB_INLINE static GatherSums<Dim> gather(const St& st, const GridGeometry<Dim>& g,
                                              const Real* __restrict rows,
                                              Real* __restrict nodal = nullptr) {
-    AxisPack wd[S];  // w_a d_a of node k, axis a in lane a (as Stencil's factors)
-    for (int k = 0; k < S; ++k) wd[k] = st.wk[k] * st.dk[k];
-    Partial<T> part;
-    gather_strips<T>(st, wd, g.strides(), rows, nodal, part);
+    const Partial<T> part = gather_rows<T>(st, g, rows, nodal);
     GatherSums<Dim> out;
     Real sum[VR<T>::N];
     part.W.store(sum);
@@ -334,12 +356,6 @@ class TensorTransfer {
   // (v_i and v_i_old together).
   template <TensorTerms T>
   using VR = VelocityRows<Dim, T.old>;
-  template <TensorTerms T>
-  struct Partial {
-    using GR = Row<VR<T>::N>;
-    GR W;
-    GR Dm[Dim], Gr[Dim];
-  };
   // The gather by stencil rows (Strip): first the sums over the leading axes of
   // whole rows, each row weighted by the product of the leading axes' factors
   // (w_a, or w_a d_a / dw_a for the moment / gradient along axis a), then each

@@ -11,6 +11,7 @@
 
 #include <string_view>
 
+#include "core/deformation.hpp"
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
 #include "core/tensor_transfer.hpp"
@@ -87,12 +88,49 @@ class ApicPolicy {
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
     P.v[p] = g.v;
     P.C[p] = g.C;
-    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    deformation_update<Dim>(P.F[p], g.grad_v, dt);
     P.x[p] += dt * g.v;
+  }
+  // The fast path's finish from the stencil sums in registers (core/
+  // policy_hooks.hpp): gather_from and finish in one, the same operations.
+  using FinishRows = ApicPolicy;
+  template <class Rows>
+  MPMTB_INLINE void finish_rows(const Rows& r, const Stencil<Dim, Kernel>& st, Particles<Dim>& P,
+                                int p, Real dt) const {
+    finish_affine_rows<false>(r, st, P, p, dt);
   }
 
  protected:
   using F_ = ScatterForm<Dim>;
+  // finish_rows of APIC and MLS-MPM: v, C (from_sums, by columns) and x, and F
+  // updated from C (kFfromC, MLS-MPM) or from grad v.
+  template <bool kFfromC, class Rows>
+  MPMTB_INLINE void finish_affine_rows(const Rows& r, const Stencil<Dim, Kernel>& st,
+                                       Particles<Dim>& P, int p, Real dt) const {
+    const AxisPack v = axis_lanes<Dim>(r.W);
+    AxisPack C[Dim], G[Dim]{};  // the columns of C_p and of grad v
+    [[maybe_unused]] const V D_inv = moments_.particle_D_inv(st);
+    for (int a = 0; a < Dim; ++a) {
+      if constexpr (Rows::terms.gradient) G[a] = axis_lanes<Dim>(r.Gr[a]);
+      if constexpr (Kernel::constant_inertia) {
+        C[a] = axis_lanes<Dim>(r.Dm[a]) * moments_.D_inv();
+      } else if constexpr (AffineMoments<Dim, Kernel>::per_particle) {
+        C[a] = axis_lanes<Dim>(r.Dm[a]) * D_inv[a];
+      } else {
+        C[a] = G[a];
+      }
+    }
+    for (int b = 0; b < Dim; ++b) {
+      P.v[p][b] = v[b];
+      for (int a = 0; a < Dim; ++a) P.C[p](b, a) = C[a][b];
+    }
+    if constexpr (kFfromC) {
+      deformation_update<Dim>(P.F[p], C, dt);
+    } else {
+      deformation_update<Dim>(P.F[p], G, dt);
+    }
+    for (int b = 0; b < Dim; ++b) P.x[p][b] += dt * v[b];
+  }
   // The same momentum as a linear form: alpha = (m_p, m_p v_p), gamma_a = m_p C_p e_a.
   void momentum_form(const Source& s, ScatterForm<Dim>& form) const {
     form.alpha[F_::m] = s.m;

@@ -79,7 +79,7 @@ class AsflipPolicy : public ApicPolicy<Dim, Kernel> {
     const V flip = P.v[p] - g.v_old;  // v_p^n - v_PIC^n
     P.v[p] = g.v + alpha_ * flip;
     P.C[p] = g.C;
-    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    deformation_update<Dim>(P.F[p], g.grad_v, dt);
     Real beta = 0;
     if constexpr (kSeparation) {
       // A pinned particle is held by its nodes: no position correction, as the

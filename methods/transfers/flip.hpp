@@ -40,7 +40,7 @@ class FlipPolicy : public PicPolicy<Dim, Kernel> {
   }
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
     P.v[p] = alpha_ * (P.v[p] + g.dv) + (1 - alpha_) * g.v;
-    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    deformation_update<Dim>(P.F[p], g.grad_v, dt);
     P.x[p] += dt * g.v;
   }
 

@@ -76,8 +76,16 @@ class MlsPolicy : public ApicPolicy<Dim, Kernel> {
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
     P.v[p] = g.v;
     P.C[p] = g.C;
-    P.F[p] = (M::Identity() + dt * g.C) * P.F[p];
+    deformation_update<Dim>(P.F[p], g.C, dt);
     P.x[p] += dt * g.v;
+  }
+  // The fast path's finish from the stencil sums in registers (core/
+  // policy_hooks.hpp): gather_from and finish in one, the same operations.
+  using FinishRows = MlsPolicy;
+  template <class Rows>
+  MPMTB_INLINE void finish_rows(const Rows& r, const Stencil<Dim, Kernel>& st, Particles<Dim>& P,
+                                int p, Real dt) const {
+    this->template finish_affine_rows<true>(r, st, P, p, dt);
   }
 };
 

@@ -11,6 +11,7 @@
 #include <string_view>
 
 #include "core/papers.hpp"
+#include "core/deformation.hpp"
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
 #include "core/tensor_transfer.hpp"
@@ -63,7 +64,7 @@ class PicPolicy {
   }
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
     P.v[p] = g.v;
-    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    deformation_update<Dim>(P.F[p], g.grad_v, dt);
     P.x[p] += dt * g.v;
   }
 };

@@ -25,6 +25,7 @@
 #include <string_view>
 #include <utility>
 
+#include "core/deformation.hpp"
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
 #include "core/stencil.hpp"
@@ -325,7 +326,7 @@ class PolypicPolicy {
       const Real root = g.modes.root_norm[a];
       P.C[p].col(a) = root > 0 ? V(c[Modes::linear(a)] / (root * dx_)) : V::Zero();
     }
-    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    deformation_update<Dim>(P.F[p], g.grad_v, dt);
     P.x[p] += dt * g.v;
   }
 

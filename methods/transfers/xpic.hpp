@@ -71,7 +71,7 @@ class XpicPolicy : public PicPolicy<Dim, Kernel> {
   }
   void finish(const Gather& g, Particles<Dim>& P, int p, Real dt) const {
     P.v[p] = g.v - g.v_old;  // S (v^{n+1} - v^n + v*)
-    P.F[p] = (M::Identity() + dt * g.grad_v) * P.F[p];
+    deformation_update<Dim>(P.F[p], g.grad_v, dt);
     P.x[p] += dt * g.v;
   }
 
