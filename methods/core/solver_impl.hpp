@@ -89,7 +89,13 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     clear_active_box(s.grid);
     bin(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
-    blocks_.for_each_coloured(s, [&](int p) { scatter_particle<true>(s, policy, p, dt); });
+    // The body force decided once: a possible call inside the particle's
+    // scatter kept its form on the stack (perf: store-forwarding stalls).
+    if (s.body_force) {
+      blocks_.for_each_coloured(s, [&](int p) { scatter_particle<true>(s, policy, p, dt); });
+    } else {
+      blocks_.for_each_coloured(s, [&](int p) { scatter_particle<false>(s, policy, p, dt); });
+    }
     if constexpr (kTensorPath) unpack_and_drain(s.grid);
   }
 
@@ -244,8 +250,9 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   }
 
  private:
-  // kBodyForce = false: the momentum part only (tauV_ is zero then). dt: the
-  // step that folded sums integrate the force over (kFoldForce).
+  // kBodyForce = false: no body force (the scene has none, or the momentum part
+  // only: tauV_ is zero then). dt: the step that folded sums integrate the
+  // force over (kFoldForce).
   template <bool kBodyForce>
   void scatter_particle(State<Dim>& s, const Policy& policy, int p, Real dt) {
     const Particles<Dim>& P = s.particles;
