@@ -1,14 +1,14 @@
 // CPDI1, convected particle domain interpolation: Sadeghirad, Brannon &
 // Burghardt 2011, "A convected particle domain interpolation technique to extend
 // applicability of the material point method for problems involving massive
-// deformations", IJNME 86(12), sec. 3.
+// deformations", IJNME 86(12).
 //
 // The particle domain is the parallelogram (parallelepiped) spanned by the
 // half-edge vectors r_a = F_p r0_a, r0_a = l0 dx e_a (l0 = 1/(2 ppc),
 // GridGeometry::l): x = x_p + J xi, J = [r_1 .. r_Dim], xi in [-1, 1]^Dim, with
 // corners x_c = x_p + J s_c, s_c in {-1, 1}^Dim. The hat N_i is replaced on the
 // domain by its multilinear interpolant from the corners, and the GIMP averages
-// (1/V_p) int N_i, (1/V_p) int grad N_i of that interpolant are (eq. 25-28 in 2D)
+// (1/V_p) int N_i, (1/V_p) int grad N_i of that interpolant are
 //   w_ip      = 2^-Dim sum_c N_i(x_c)
 //   grad w_ip = sum_c N_i(x_c) g_c,   g_c = 2^-Dim J^-T s_c
 // (the integral of grad Q_c over the domain is det J J^-T s_c, V_p = 2^Dim det J).
@@ -66,6 +66,15 @@ struct CpdiKernel {
   // Largest half-extent of the domain along an axis, in cells (the 4-node box).
   static constexpr Real kMaxHalfExtent = Real(0.999);
 
+  // Whether the domain l0 F exceeds the box and is scaled into it (reported by
+  // the runs: summary `domains_clamped_max`, core/registry.hpp).
+  template <int Dim>
+  static bool domain_clamped(Real l0, const Mat<Dim>& F) {
+    for (int a = 0; a < Dim; ++a)
+      if (!(l0 * F.row(a).cwiseAbs().sum() <= kMaxHalfExtent)) return true;
+    return false;
+  }
+
   // The 1D form at F = I (reference for the tests): the hat at the two corners
   // r -+ l, averaged, and its CPDI gradient (hat(r + l) - hat(r - l)) / (2l).
   static Real hat(Real r) {
@@ -118,7 +127,7 @@ struct Stencil<Dim, CpdiKernel> {
       for (int a = 0; a < Dim; ++a)
         first[a] = std::min(first[a], static_cast<int>(std::floor(xc[c][a])));
     }
-    // g_c = 2^-Dim J^-T s_c in physical units (Sadeghirad et al. 2011, eq. 28).
+    // g_c = 2^-Dim J^-T s_c in physical units (Sadeghirad et al. 2011).
     const Mat<Dim> JinvT = J.inverse().transpose() * (g.inv_dx / corners);
     for (int n = 0; n < count; ++n) {
       w_[n] = 0;
@@ -147,7 +156,7 @@ struct Stencil<Dim, CpdiKernel> {
       }
     }
     for (int n = 0; n < count; ++n) {
-      w_[n] *= Real(1) / corners;  // eq. 26: the corners' average
+      w_[n] *= Real(1) / corners;  // the corners' average
       int rest = n;
       for (int a = Dim - 1; a >= 0; --a) {
         d_[n][a] = (first[a] + rest % S - xi[a]) * g.dx;

@@ -1,6 +1,6 @@
-// Contiguous-particle GIMP (cpGIMP): Bardenhagen & Kober 2004, CMES 5(6), sec. 3
+// Contiguous-particle GIMP (cpGIMP): Bardenhagen & Kober 2004, CMES 5(6)
 // (the particle domain follows the deformation), in the axis-aligned form of
-// Wallstedt & Guilkey 2008, JCP 227, sec. 2: the domain stays a box whose
+// Wallstedt & Guilkey 2008, JCP 227: the domain stays a box whose
 // half-width along axis a is l_a = l0 F_aa (l0 = 1/(2 ppc), GridGeometry::l), so
 // the weight is uGIMP's (kernels/gimp.hpp, eq. 40 of Bardenhagen & Kober) with a
 // per-particle, per-axis half-width, and stays a tensor product. The shear terms
@@ -59,6 +59,14 @@ struct CpGimpKernel {
   static bool clamped(Real l0, Real F_aa) {
     const Real l = l0 * F_aa;
     return !(l >= kMinHalfWidth && l <= kMaxHalfWidth);
+  }
+  // Whether any of the particle's half-widths is clamped (reported by the runs:
+  // summary `domains_clamped_max`, core/registry.hpp).
+  template <int Dim>
+  static bool domain_clamped(Real l0, const Mat<Dim>& F) {
+    for (int a = 0; a < Dim; ++a)
+      if (clamped(l0, F(a, a))) return true;
+    return false;
   }
 
   // S(r) and dS/dr for one half-width l <= 1, the hat averaged over [r - l, r + l]

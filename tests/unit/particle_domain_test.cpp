@@ -190,7 +190,7 @@ TEST(Cpdi, LinearlyExactAtRandomF) {
 }
 
 // The CPDI gradient is (1/V_p) oint N_i^h n ds with N_i^h linear along each edge
-// between its corner values (Sadeghirad et al. 2011, eq. 27-28): the trapezoid rule
+// between its corner values (Sadeghirad et al. 2011): the trapezoid rule
 // per edge of the parallelogram, computed here from the hats at the corners.
 TEST(Cpdi, GradientIsTheBoundaryIntegralOfTheCornerInterpolant) {
   std::mt19937 gen(31);
