@@ -35,9 +35,10 @@ constexpr bool kernel_uses_half_width = requires(Real* out) {
 };
 
 // Kernels whose particle domain follows the particle's deformation gradient F
-// (cpGIMP, kernels/cpgimp.hpp) declare deformed_domain = true and half_width(l0,
-// F_aa): their stencil is built by Stencil(x_p, F_p, geo). Stencil(x_p, geo) is
-// then the undeformed domain (F = I).
+// declare deformed_domain = true: their stencil is built by Stencil(x_p, F_p, geo),
+// and Stencil(x_p, geo) is the undeformed domain (F = I). cpGIMP
+// (kernels/cpgimp.hpp) declares half_width(l0, F_aa) for the constructor below;
+// CPDI (kernels/cpdi.hpp) specialises Stencil and TensorTransfer itself.
 template <class Kernel>
 constexpr bool kernel_deformed_domain = [] {
   if constexpr (requires { Kernel::deformed_domain; }) {
