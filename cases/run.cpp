@@ -255,6 +255,8 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
       const Diagnostics d = measure(s, *stepper);
       mon.J_min = std::min(mon.J_min, d.J_min);
       mon.J_max = std::max(mon.J_max, d.J_max);
+      mon.domains_clamped_max = std::max(
+          mon.domains_clamped_max, clamped_domains<Dim>(scene.kernel, s.particles.F, s.grid.geo.l));
       auto row = sample(d);
       // Energy above the limit times what was put in (initial kinetic + strain
       // energy plus the work of gravity and colliders) means the scheme is amplifying.
@@ -328,6 +330,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   j["drift"] = mon.drift.json();
   j["J_min"] = mon.J_min;
   j["J_max"] = mon.J_max;
+  if (mon.domains_clamped_max >= 0) j["domains_clamped_max"] = mon.domains_clamped_max;
   j["J_elastic_min"] = mon.J_elastic_min;
   j["J_elastic_max"] = mon.J_elastic_max;
   if (frames.enabled()) j["frames"] = frames.summary();

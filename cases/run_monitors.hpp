@@ -96,7 +96,10 @@ struct RunMonitors {
   double step_seconds = 0;         // time spent stepping, over every session of the run
   double wall_seconds = 0;         // wall time of the sessions before this one
   std::uint64_t series_bytes = 0;  // series.csv's length at this state
-  long sessions = 1;               // 1 + the times the run was resumed
+  // Kernels with deformed domains (cpGIMP, CPDI): the most particles whose domain
+  // was clamped to the support at an output time (-1: a fixed-domain kernel).
+  long domains_clamped_max = -1;
+  long sessions = 1;  // 1 + the times the run was resumed
 };
 
 }  // namespace mpmtb

@@ -218,6 +218,7 @@ void read_bodies(TableReader& top, Scene& s) {
     b.material = material_index(s, r.string("material"), path + ".material");
     b.velocity = r.vec3_or("velocity", Vec3::Zero());
     b.angular_velocity = r.vec3_or("angular_velocity", Vec3::Zero());
+    b.stretch_rate = r.vec3_or("stretch_rate", Vec3::Zero());
     if (r.has("cut_min") || r.has("cut_max")) {
       b.cut_min = r.vec3("cut_min");
       b.cut_max = r.vec3("cut_max");

@@ -32,6 +32,9 @@ struct BodySpec {
   int material = 0;
   Vec3 velocity = Vec3::Zero();
   Vec3 angular_velocity = Vec3::Zero();  // about the body's centre; 2D uses z
+  // Homogeneous stretching about the body's centre: v += diag(stretch_rate) (x - centre)
+  // (`stretch_rate`, 1/s per axis; bar_stretch.toml).
+  Vec3 stretch_rate = Vec3::Zero();
   // A box cut out of the body (`cut_min`, `cut_max`: a notch or a slot); empty when
   // cut_max does not exceed cut_min.
   Vec3 cut_min = Vec3::Zero(), cut_max = Vec3::Zero();

@@ -13,7 +13,7 @@ namespace {
 template <int Dim>
 Vec<Dim> rigid_velocity(const BodySpec& b, const Vec3& x) {
   const Vec3 r = x - b.rotation_center();
-  Vec3 v = b.velocity;
+  Vec3 v = b.velocity + b.stretch_rate.cwiseProduct(r);
   if constexpr (Dim == 2) {
     v += Vec3(-b.angular_velocity[2] * r[1], b.angular_velocity[2] * r[0], 0);
   } else if constexpr (Dim == 3) {

@@ -47,6 +47,9 @@ single_runs=(
   "single_point-flip-linear-usf|single_point --transfer flip --kernel linear --update-order usf"
   "single_point-flip-linear-musl|single_point --transfer flip --kernel linear --update-order musl"
   "translating2d-asflip-gimp|translating_block --dim 2 --transfer asflip --kernel gimp --cells 16 --t-end 0.2"
+  "bar_stretch1d-mls-cpgimp|bar_stretch --dim 1 --transfer mls --kernel cpgimp --t-end 0.5"
+  "bar_stretch2d-flip-cpdi|bar_stretch --dim 2 --transfer flip --kernel cpdi --t-end 0.5"
+  "rotating2d-tpic-cpdi|rotating --dim 2 --transfer tpic --kernel cpdi --cells 16 --t-end 0.3"
   "column-apic-quadratic-sand|column --transfer apic --kernel quadratic --cells 32 --t-end 0.05"
   "pinned_block3d-mls-quadratic-damage|pinned_block --transfer mls --kernel quadratic --t-end 0.004"
 )

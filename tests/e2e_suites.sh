@@ -29,7 +29,12 @@ def weight(kernel, r, l):
     """N(r) and dN/dx_p for the kernels of shared/REFERENCE.md (dx = 1); l is uGIMP's
     particle half-width 1/(2 ppc) (Bardenhagen & Kober 2004, eq. 40)."""
     a, s = abs(r), math.copysign(1.0, r)
-    if kernel == "gimp":
+    if kernel == "cpdi":
+        # CPDI1 at F = I (kernels/cpdi.hpp): the hat at the domain's corners r -+ l,
+        # averaged; the gradient (hat(r + l) - hat(r - l)) / (2l) (uGIMP's).
+        hat = lambda x: max(0.0, 1 - abs(x))
+        return (hat(r - l) + hat(r + l)) / 2, (hat(r + l) - hat(r - l)) / (2 * l)
+    if kernel in ("gimp", "cpgimp"):  # cpGIMP at F = I is uGIMP
         if a < l:
             return 1 - (r * r + l * l) / (2 * l), -r / l
         if a < 1 - l:
@@ -106,7 +111,8 @@ for s in stable:
                 and float(r["cfl"]) >= 1.25 * high:
             assert r["status"] == "unstable" and r["reason"] and r["fail_step"], r
     checked += 1
-assert checked == 2 * 4 * 2, f"checked {checked} method x ppc combinations"
+# APIC and MLS-MPM with 5 kernels (both refuse CPDI: its D_p is full), 2 ppc each.
+assert checked == 2 * 5 * 2, f"checked {checked} method x ppc combinations"
 print(f"stability: {checked} limits within +-25 % of the von Neumann estimate, "
       "PIC's on its derived limit")
 PY

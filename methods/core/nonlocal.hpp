@@ -152,7 +152,7 @@ class NonlocalLaplacian {
       if (!requested(P, p)) return;
       const LaplacianRequest& r = requests_[P.material[p]];
       const Real mp = P.m[p], mq = mp * P.state_of(p)[r.source];
-      const StencilT st(P.x[p], geo);
+      const StencilT st(P.x[p], P.F[p], geo);
       const auto add_mq = [&](long node, Real w) {
         m_[node] += w * mp;
         q_[node] += w * mq;
@@ -255,7 +255,7 @@ class NonlocalLaplacian {
     for (long p = 0; p < n; ++p) {
       if (!requested(P, p)) continue;
       Real lap = 0, diag = 0;
-      StencilT(P.x[p], geo)
+      StencilT(P.x[p], P.F[p], geo)
           .for_each_node(geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
             lap += w * lap_[node];
             if (aniso_) diag += w * diag_[node];

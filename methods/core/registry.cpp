@@ -90,6 +90,23 @@ std::unique_ptr<Stepper<Dim>> make_stepper(std::string_view transfer, std::strin
   return stepper;
 }
 
+template <int Dim>
+long clamped_domains(std::string_view kernel, const std::vector<Mat<Dim>>& F, Real l0) {
+  long count = -1;
+  AllKernels::for_each([&]<class K>() {
+    if constexpr (requires { K::template domain_clamped<Dim>(l0, F[0]); }) {
+      if (K::name != kernel) return;
+      count = 0;
+      for (const auto& Fp : F) count += K::template domain_clamped<Dim>(l0, Fp);
+    }
+  });
+  return count;
+}
+
+template long clamped_domains<1>(std::string_view, const std::vector<Mat<1>>&, Real);
+template long clamped_domains<2>(std::string_view, const std::vector<Mat<2>>&, Real);
+template long clamped_domains<3>(std::string_view, const std::vector<Mat<3>>&, Real);
+
 template std::unique_ptr<Stepper<1>> make_stepper<1>(std::string_view, std::string_view,
                                                      Parameters&);
 template std::unique_ptr<Stepper<2>> make_stepper<2>(std::string_view, std::string_view,

@@ -36,4 +36,10 @@ template <int Dim>
 std::unique_ptr<Stepper<Dim>> make_stepper(std::string_view transfer, std::string_view kernel,
                                            Parameters& transfer_params);
 
+// Kernels whose particle domain follows F (cpGIMP, CPDI) clamp it to their
+// support: the number of particles of F whose domain (initial half-width l0 in
+// cells, GridGeometry::l) is clamped now; -1 for kernels with a fixed domain.
+template <int Dim>
+long clamped_domains(std::string_view kernel, const std::vector<Mat<Dim>>& F, Real l0);
+
 }  // namespace mpmtb

@@ -84,6 +84,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   }
 
   void particles_to_grid(State<Dim>& s, Real dt) override {
+    this->forget_start_F();
     compute_stresses(s);
     s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
@@ -161,7 +162,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     reduction(max                                                                 \
               : J_max, v2_max) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
-      const StencilT st(P.x[p], g.geo);
+      const StencilT st(P.x[p], this->domain_F(P, p), g.geo);
       // kDeform = false: the finish may update F, the motion part keeps it.
       const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
         if constexpr (kDeform) {
@@ -220,7 +221,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
       const Particles<Dim>& P = s.particles;
       for (std::size_t p = 0; p < P.size(); ++p) {
         // B_p = C_p D_p; L_a = m_p eps_abc B_cb (REFERENCE.md; Jiang et al. 2015).
-        const Vec<Dim> D = StencilT(P.x[p], s.grid.geo).inertia_diagonal();
+        const Vec<Dim> D = StencilT(P.x[p], P.F[p], s.grid.geo).inertia_diagonal();
         const Mat<Dim> B = P.C[p] * D.asDiagonal();
         if constexpr (Dim == 2) {
           L[2] += P.m[p] * (B(1, 0) - B(0, 1));
@@ -237,6 +238,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   // The split stages of the other update orders (core/stepper.hpp).
   // P2G momentum part: the transfer's own P2G with zero stress and no body force.
   void scatter_momentum(State<Dim>& s) override {
+    this->forget_start_F();
     tauV_.assign(s.particles.size(), Mat<Dim>::Zero());
     s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
@@ -257,7 +259,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   void scatter_particle(State<Dim>& s, const Policy& policy, int p, Real dt) {
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
-    const StencilT st(P.x[p], g.geo);
+    const StencilT st(P.x[p], P.F[p], g.geo);
     const auto src = prepare_source(policy, P, p, tauV_[p], st);  // core/policy_hooks.hpp
     Real* m = g.m.data();
     Vec<Dim>* mom = g.p.data();
@@ -312,7 +314,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
       for (long p = 0; p < n; ++p) {
         q_particle_[p] = TensorTransfer<Dim, Kernel>::template gather<TensorTerms{}>(
-                             StencilT(P.x[p], g.geo), g.geo, v_rows_.data())
+                             StencilT(P.x[p], this->domain_F(P, p), g.geo), g.geo, v_rows_.data())
                              .v;
       }
       const bool with_mass = j == 1;  // the nodal masses of S+ do not change within the step
@@ -321,7 +323,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
         if (with_mass) q_mass_[i] = 0;
       });
       blocks_.for_each_coloured(s, [&](int p) {
-        StencilT(P.x[p], g.geo)
+        StencilT(P.x[p], this->domain_F(P, p), g.geo)
             .for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
               const Real wm = w * P.m[p];
               q_sum_[node] += wm * q_particle_[p];

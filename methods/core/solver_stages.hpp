@@ -88,6 +88,19 @@ class SolverStages : public Stepper<Dim> {
     g.active.for_each_node(g.geo.strides(), f);
   }
 
+  // The F that shapes the particle domains (kernel_deformed_domain: cpGIMP, CPDI)
+  // within a step: F_p at the step's start, also once update_deformation has moved
+  // F on (usf), so that the force scatter and G2P use the momentum scatter's
+  // stencils. Other kernels ignore it.
+  const Mat<Dim>& domain_F(const Particles<Dim>& P, long p) const {
+    if constexpr (kernel_deformed_domain<Kernel>) {
+      if (F_start_kept_) return F_start_[p];
+    }
+    return P.F[p];
+  }
+  // A new step's P2G: the domains follow the particles' current F again.
+  void forget_start_F() { F_start_kept_ = false; }
+
   std::vector<Mat<Dim>> tauV_;       // V0_p tau_p, from the materials
   NodeSums<Dim, kFold> sums_;        // the fast path's P2G accumulator
   bool sums_kept_ = false;           // sums_ holds scatter_momentum's sums (see clear_active_box)
@@ -99,6 +112,8 @@ class SolverStages : public Stepper<Dim> {
   void scatter_force(State<Dim>& s, int p, Real dt);
 
   bool tensor_path_;
+  std::vector<Mat<Dim>> F_start_;  // domain_F: F_p before update_deformation
+  bool F_start_kept_ = false;
   std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
   std::vector<Vec<Dim>> p_kept_;
   NonlocalLaplacian<Dim, Kernel> nonlocal_;

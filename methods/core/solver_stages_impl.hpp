@@ -84,7 +84,8 @@ void SolverStages<Dim, Kernel, kFold>::scatter_force(State<Dim>& s, int p, Real 
   Form form;
   for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(Form::f) = -tauV_[p].col(a);
   if (s.body_force) form.alpha.template segment<Dim>(Form::f) = P.m[p] * s.body_force(P, p, s.time);
-  add_form<TensorTerms{.gradient = true}>(StencilT(P.x[p], s.grid.geo), s.grid.geo, form, dt);
+  add_form<TensorTerms{.gradient = true}>(StencilT(P.x[p], domain_F(P, p), s.grid.geo), s.grid.geo,
+                                          form, dt);
 }
 
 // v_i = p_i / m_i with walls, pinned nodes and colliders, for the F update.
@@ -128,6 +129,7 @@ StepReport SolverStages<Dim, Kernel, kFold>::update_deformation(State<Dim>& s, R
   const Grid<Dim>& g = s.grid;
   pack_velocities(v_rows_, g, g.v.data(), nullptr);
   const long n = static_cast<long>(P.size());
+  if constexpr (kernel_deformed_domain<Kernel>) F_start_.resize(n);
   Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min;
   long non_finite = n;
 #pragma omp parallel for schedule(static) reduction(min                  \
@@ -135,7 +137,8 @@ StepReport SolverStages<Dim, Kernel, kFold>::update_deformation(State<Dim>& s, R
     reduction(max                                                        \
               : J_max) if (n >= kParallelMinimum)
   for (long p = 0; p < n; ++p) {
-    const StencilT st(P.x[p], g.geo);
+    const StencilT st(P.x[p], P.F[p], g.geo);
+    if constexpr (kernel_deformed_domain<Kernel>) F_start_[p] = P.F[p];
     const Mat<Dim> G =
         Sums::template gather<TensorTerms{.gradient = true}>(st, g.geo, v_rows_.data()).G;
     deformation_update<Dim>(P.F[p], G, dt);
@@ -144,6 +147,7 @@ StepReport SolverStages<Dim, Kernel, kFold>::update_deformation(State<Dim>& s, R
     J_max = std::max(J_max, J);
     if (!std::isfinite(J)) non_finite = std::min(non_finite, p);
   }
+  F_start_kept_ = kernel_deformed_domain<Kernel>;
   return {J_min, J_max, 0, non_finite == n ? -1 : non_finite, -1};
 }
 

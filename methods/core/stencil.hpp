@@ -34,6 +34,20 @@ constexpr bool kernel_uses_half_width = requires(Real* out) {
   Kernel::weights(Real(1), out, out, Real(1));
 };
 
+// Kernels whose particle domain follows the particle's deformation gradient F
+// declare deformed_domain = true: their stencil is built by Stencil(x_p, F_p, geo),
+// and Stencil(x_p, geo) is the undeformed domain (F = I). cpGIMP
+// (kernels/cpgimp.hpp) declares half_width(l0, F_aa) for the constructor below;
+// CPDI (kernels/cpdi.hpp) specialises Stencil and TensorTransfer itself.
+template <class Kernel>
+constexpr bool kernel_deformed_domain = [] {
+  if constexpr (requires { Kernel::deformed_domain; }) {
+    return Kernel::deformed_domain;
+  } else {
+    return false;
+  }
+}();
+
 // Kernels whose D_p = sum w (x_i - x_p)(x_i - x_p)^T is neither constant (B-splines)
 // nor singular (the hat): the affine transfers take the particle's own D_p.
 template <class Kernel>
@@ -104,6 +118,27 @@ struct Stencil {
           set(a, k, Kernel::N(r), Kernel::dN(r) * inv_dx, -r * g.dx);
         }
       }
+      base_node += static_cast<long>(first + GridGeometry<Dim>::pad) * g.strides()[a];
+    }
+  }
+
+  // The stencil of a particle of deformation gradient F: for kernels with a
+  // deformed domain (cpGIMP) the half-width along axis a is Kernel::half_width(l0,
+  // F_aa), l0 = GridGeometry::l; every other kernel ignores F (the constructor above).
+  MPMTB_INLINE Stencil(const Vec<Dim>& xp, const Mat<Dim>&,
+                       const GridGeometry<Dim>& g) requires(!kernel_deformed_domain<Kernel>)
+      : Stencil(xp, g) {}
+  MPMTB_INLINE Stencil(const Vec<Dim>& xp, const Mat<Dim>& F,
+                       const GridGeometry<Dim>& g) requires(kernel_deformed_domain<Kernel>) {
+    const Real inv_dx = g.inv_dx;
+    for (int k = 0; k < S; ++k) wk[k] = dwk[k] = dk[k] = AxisPack{};  // (the padding lanes)
+    for (int a = 0; a < Dim; ++a) {
+      const Real xi = (xp[a] - g.lo[a]) * inv_dx;
+      const int first = first_index(xi);
+      const Real r0 = xi - first;
+      Real w_a[S], dw_a[S];
+      Kernel::weights(r0, w_a, dw_a, Kernel::half_width(g.l, F(a, a)));
+      for (int k = 0; k < S; ++k) set(a, k, w_a[k], dw_a[k] * inv_dx, -(r0 - k) * g.dx);
       base_node += static_cast<long>(first + GridGeometry<Dim>::pad) * g.strides()[a];
     }
   }

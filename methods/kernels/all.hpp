@@ -15,6 +15,8 @@ using AllKernels = TypeList<
     , QuadraticKernel
     , CubicKernel
     , GimpKernel
+    , CpGimpKernel
+    , CpdiKernel
     >;
 // clang-format on
 

@@ -73,15 +73,17 @@ struct GimpKernel {
   // and hat(x) = 1 - |c|. Equal to N(r, l) and dN(r, l) up to round-off.
   static void weights(Real r0, Real* w, Real* dw, Real l = default_half_width) {
     const Real inv_2l = 1 / (2 * l);
-    for (int k = 0; k < support; ++k) {
-      const Real r = r0 - k;
-      const Real cp = std::clamp(r + l, Real(-1), Real(1));
-      const Real cm = std::clamp(r - l, Real(-1), Real(1));
-      const Real phi_p = cp - Real(0.5) * cp * std::abs(cp);
-      const Real phi_m = cm - Real(0.5) * cm * std::abs(cm);
-      w[k] = (phi_p - phi_m) * inv_2l;
-      dw[k] = (std::abs(cm) - std::abs(cp)) * inv_2l;
-    }
+    for (int k = 0; k < support; ++k) averaged_hat(r0 - k, l, inv_2l, w[k], dw[k]);
+  }
+  // S and dS/dr at one node, r = (x_p - x_i)/dx, inv_2l = 1 / (2l) (shared with cpGIMP,
+  // kernels/cpgimp.hpp).
+  static void averaged_hat(Real r, Real l, Real inv_2l, Real& w, Real& dw) {
+    const Real cp = std::clamp(r + l, Real(-1), Real(1));
+    const Real cm = std::clamp(r - l, Real(-1), Real(1));
+    const Real phi_p = cp - Real(0.5) * cp * std::abs(cp);
+    const Real phi_m = cm - Real(0.5) * cm * std::abs(cm);
+    w = (phi_p - phi_m) * inv_2l;
+    dw = (std::abs(cm) - std::abs(cp)) * inv_2l;
   }
 };
 

@@ -11,10 +11,27 @@
 // stencil (Stencil::inertia_diagonal), passed in as D_p^-1 (`Dp_inv`).
 #pragma once
 
+#include <string_view>
+
 #include "core/stencil.hpp"
 #include "core/types.hpp"
 
 namespace mpmtb {
+
+// Kernels whose D_p is a full matrix (CPDI: J J^T under shear, kernels/cpdi.hpp)
+// declare full_inertia = true; the transfers below take D_p diagonal (a constant,
+// the hat's gradient form, or the particle's own diagonal), so they refuse them.
+template <class Kernel>
+constexpr bool kernel_full_inertia = [] {
+  if constexpr (requires { Kernel::full_inertia; }) {
+    return Kernel::full_inertia;
+  } else {
+    return false;
+  }
+}();
+inline constexpr std::string_view kFullInertiaRefusal =
+    "the kernel's D_p is a full matrix (CPDI: J J^T plus the corners' hat variances) and this "
+    "transfer takes D_p diagonal (transfers/affine.hpp); use pic, flip, xpic or tpic";
 
 template <int Dim, class Kernel>
 class AffineMoments {

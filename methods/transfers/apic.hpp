@@ -168,8 +168,8 @@ struct ApicTransfer {
   static constexpr bool conserves_angular_momentum = true;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>
-  static constexpr bool supports = true;
-  static constexpr std::string_view unsupported_reason = "";
+  static constexpr bool supports = !kernel_full_inertia<Kernel>;
+  static constexpr std::string_view unsupported_reason = kFullInertiaRefusal;
   template <int Dim, class Kernel>
   using Policy = ApicPolicy<Dim, Kernel>;
 };

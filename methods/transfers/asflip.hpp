@@ -118,8 +118,8 @@ struct AflipTransfer {
   static constexpr bool conserves_angular_momentum = false;
   static constexpr bool needs_old_velocity = true;
   template <class Kernel>
-  static constexpr bool supports = true;
-  static constexpr std::string_view unsupported_reason = "";
+  static constexpr bool supports = !kernel_full_inertia<Kernel>;
+  static constexpr std::string_view unsupported_reason = kFullInertiaRefusal;
   template <int Dim, class Kernel>
   using Policy = AsflipPolicy<Dim, Kernel, false>;
 };
@@ -139,8 +139,8 @@ struct AsflipTransfer {
   // dt sum m_i v_i: the centre of mass drifts from the momentum's path.
   static constexpr bool positions_follow_momentum = false;
   template <class Kernel>
-  static constexpr bool supports = true;
-  static constexpr std::string_view unsupported_reason = "";
+  static constexpr bool supports = !kernel_full_inertia<Kernel>;
+  static constexpr std::string_view unsupported_reason = kFullInertiaRefusal;
   template <int Dim, class Kernel>
   using Policy = AsflipPolicy<Dim, Kernel, true>;
 };

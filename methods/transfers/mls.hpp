@@ -114,8 +114,8 @@ struct MlsTransfer {
   // so P2G and G2P cannot be split: only update_order = "usl" (core/stepper.hpp).
   static constexpr bool gradient_based = false;
   template <class Kernel>
-  static constexpr bool supports = true;
-  static constexpr std::string_view unsupported_reason = "";
+  static constexpr bool supports = !kernel_full_inertia<Kernel>;
+  static constexpr std::string_view unsupported_reason = kFullInertiaRefusal;
   template <int Dim, class Kernel>
   using Policy = MlsPolicy<Dim, Kernel>;
 };

@@ -30,6 +30,7 @@
 #include "core/particles.hpp"
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
+#include "transfers/affine.hpp"
 
 namespace mpmtb {
 
@@ -371,8 +372,8 @@ struct PolypicTransfer {
   static constexpr bool conserves_angular_momentum = true;
   static constexpr bool needs_old_velocity = false;
   template <class Kernel>
-  static constexpr bool supports = true;
-  static constexpr std::string_view unsupported_reason = "";
+  static constexpr bool supports = !kernel_full_inertia<Kernel>;
+  static constexpr std::string_view unsupported_reason = kFullInertiaRefusal;
   template <int Dim, class Kernel>
   using Policy = PolypicPolicy<Dim, Kernel>;
 };

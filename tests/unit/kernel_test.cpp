@@ -147,10 +147,11 @@ bool NearBreakpoint(Real r, Real margin) {
   return std::abs(4 * r - std::round(4 * r)) < 4 * margin;
 }
 
-// Radius of the kernel's support in cells: support / 2, or 1 + l for uGIMP (default l).
+// Radius of the kernel's support in cells: support / 2, or 1 + l for the particle-domain
+// kernels (uGIMP, cpGIMP and CPDI at F = I, default l).
 template <class K>
 Real SupportRadius() {
-  if constexpr (std::is_same_v<K, GimpKernel>) {
+  if constexpr (requires { K::default_half_width; }) {
     return 1 + K::default_half_width;
   } else {
     return K::support / Real(2);
@@ -168,12 +169,25 @@ Real GimpInertia(Real xi, Real l) {
   return (H(xi + l) - H(xi - l)) / (2 * l) + l * l / 3;
 }
 
+// CPDI's gradient is the domain average of the hat's corner interpolant, d N / d r only
+// where the hat is linear over the whole domain [r - l, r + l] (kernels/cpdi.hpp).
+template <class K>
+bool KinkInsideDomain(Real r) {
+  if constexpr (std::is_same_v<K, CpdiKernel>) {
+    const Real l = K::default_half_width;
+    for (const Real kink : {-1.0, 0.0, 1.0}) {
+      if (kink > r - l - 1e-4 && kink < r + l + 1e-4) return true;
+    }
+  }
+  return false;
+}
+
 TYPED_TEST(KernelTest, ShapeIsNonNegativeAndDerivativeMatchesFiniteDifference) {
   using K = TypeParam;
   const Real h = 1e-6, half = SupportRadius<K>();
   for (Real r = -half - 0.25; r <= half + 0.25; r += 0.001237) {
     EXPECT_GE(K::N(r), 0) << "r = " << r;
-    if (NearBreakpoint(r, 1e-4)) continue;
+    if (NearBreakpoint(r, 1e-4) || KinkInsideDomain<K>(r)) continue;
     EXPECT_NEAR(K::dN(r), (K::N(r + h) - K::N(r - h)) / (2 * h), 1e-8) << "r = " << r;
   }
 }
@@ -191,10 +205,11 @@ void CheckStencilGradientByDifferences() {
   };
   const Real h = 1e-6 * g.dx;
   int checked = 0;
-  for (const auto& xp : Samples(g, 60)) {
+  // CPDI: only the positions whose domain holds no grid line (1/2^Dim of them) count.
+  for (const auto& xp : Samples(g, std::is_same_v<K, CpdiKernel> ? 600 : 60)) {
     const Vec<Dim> f = CellFraction(xp, g);
     bool skip = false;
-    for (int a = 0; a < Dim; ++a) skip |= NearBreakpoint(f[a], 1e-4);
+    for (int a = 0; a < Dim; ++a) skip |= NearBreakpoint(f[a], 1e-4) || KinkInsideDomain<K>(f[a]);
     if (skip) continue;
     ++checked;
     std::array<std::map<long, Real>, Dim> wp, wm;  // missing node: weight 0
@@ -234,8 +249,17 @@ void CheckInertia() {
     } else if constexpr (std::is_same_v<K, LinearKernel>) {
       const Vec<Dim> f = CellFraction(xp, g);
       expected = (f.array() * (1 - f.array())).matrix() * dx2;
-    } else if constexpr (std::is_same_v<K, GimpKernel>) {
+    } else if constexpr (std::is_same_v<K, GimpKernel> || std::is_same_v<K, CpGimpKernel>) {
       for (int a = 0; a < Dim; ++a) expected[a] = GimpInertia((xp[a] - g.lo[a]) / g.dx, g.l) * dx2;
+    } else if constexpr (std::is_same_v<K, CpdiKernel>) {
+      // The corners' hat variances f (1 - f), averaged, plus J J^T = l^2 I (F = I).
+      for (int a = 0; a < Dim; ++a) {
+        const Real xi = (xp[a] - g.lo[a]) / g.dx;
+        Real v = 0;
+        for (const Real c : {xi - g.l, xi + g.l})
+          v += (c - std::floor(c)) * (1 - (c - std::floor(c)));
+        expected[a] = (v / 2 + g.l * g.l) * dx2;
+      }
     } else {
       FAIL() << "no expected D_p for a kernel without constant inertia";
     }
