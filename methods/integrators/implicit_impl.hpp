@@ -315,7 +315,9 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     for (long p = 0; p < n; ++p) {
       const Mat<Dim> Pp = s_->materials[P.material[p]]->first_piola(F_[p], P.state_of(p));
       Q_[p] = P.V0[p] * Pp * Fn_[p].transpose();
-      noise += P.V0[p] * Pp.norm() * F_[p].norm();
+      const ConstitutiveModel<Dim>& model = *s_->materials[P.material[p]];
+      const Real c = model.wave_speed();
+      noise += P.V0[p] * (Pp.norm() + model.density() * c * c * F_[p].norm()) * F_[p].norm();
     }
     psi_noise_ = std::numeric_limits<Real>::epsilon() * noise;
     scatter_Q(out);
@@ -505,8 +507,10 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
           accepted = true;
           break;
         }
-        // The round-off of E: eps |E|, and eps |P| |F| per particle (psi(F) is
-        // known to P : dF with |dF| ~ eps |F|; F - I cancels at small strain).
+        // The round-off of E: eps |E|, and per particle eps V0 (|P| + rho c^2 |F|) |F|:
+        // psi(F) is known to P : dF with |dF| ~ eps |F| where F - I cancels at
+        // small strain, and its terms of size rho c^2 |F|^2 cancel near rest
+        // (neo-Hookean's mu/2 tr(F^T F) against mu ln J).
         const Real noise = 64 * (std::numeric_limits<Real>::epsilon() * std::abs(E) + psi_noise_);
         if (ls == 0 && E_new - E <= noise) {
           gradient(trial, grad_new);
