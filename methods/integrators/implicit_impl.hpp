@@ -529,7 +529,8 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
       gradient(u, grad);
       gnorm = std::sqrt(dot(grad, grad));
     }
-    stats_.residual = g0 > 0 ? gnorm / g0 : 0;
+    // 0 where v~ already solves the step to round-off (free fall, rest).
+    stats_.residual = g0 > floor ? gnorm / g0 : 0;
     if (!std::isfinite(gnorm)) stats_.converged = false;
     return u;
   }
