@@ -186,9 +186,11 @@ class Stepper {
 
 template <int Dim>
 void Stepper<Dim>::set_integrator(Integrator i, const ImplicitOptions& options) {
-  integrator_ = i;
-  implicit_.reset();
-  if (i == Integrator::explicit_euler) return;
+  if (i == Integrator::explicit_euler) {
+    integrator_ = i;
+    implicit_.reset();
+    return;
+  }
   const std::string name(integrator_name(i));
   if (!gradient_based() || transfer_name() == "xpic") {
     throw InputError(
@@ -202,6 +204,7 @@ void Stepper<Dim>::set_integrator(Integrator i, const ImplicitOptions& options) 
                      "' has its own stage order; method.update_order must be usl");
   }
   implicit_ = make_implicit_solve<Dim>(kernel_name(), i, options);
+  integrator_ = i;  // only once accepted: a refused integrator leaves the step as it was
 }
 
 }  // namespace mpmtb

@@ -198,6 +198,8 @@ TEST(ImplicitInput, NonGradientTransfersAndOtherOrdersAreRefused) {
       EXPECT_NE(what.find("method.integrator"), std::string::npos) << what;
       EXPECT_NE(what.find("allowed: pic, flip, apic"), std::string::npos) << what;
     }
+    EXPECT_EQ(stepper->integrator(), Integrator::explicit_euler);  // left as it was
+    EXPECT_EQ(stepper->implicit_stats(), nullptr);
     EXPECT_NO_THROW(stepper->set_integrator(Integrator::explicit_euler));
   }
   Parameters params("apic");
