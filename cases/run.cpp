@@ -66,6 +66,38 @@ Real gyration_radius(const State<Dim>& s, const Diagnostics& d) {
   return d.mass > 0 ? std::sqrt(sum / d.mass) : 0;
 }
 
+// The implicit solve's figures: per series row and over the run.
+struct ImplicitTally {
+  long row_newton = 0, row_cg = 0;
+  Real row_residual = 0;
+  long steps = 0, newton_total = 0, newton_max = 0, cg_total = 0, cg_max = 0;
+  Real residual_max = 0;
+  void add(const ImplicitStats& st) {
+    row_newton += st.newton;
+    row_cg += st.cg;
+    row_residual = std::max(row_residual, st.residual);
+    ++steps;
+    newton_total += st.newton;
+    newton_max = std::max<long>(newton_max, st.newton);
+    cg_total += st.cg;
+    cg_max = std::max(cg_max, st.cg);
+    residual_max = std::max(residual_max, st.residual);
+  }
+  void next_row() { row_newton = row_cg = 0, row_residual = 0; }
+  nlohmann::json json(const Scene& scene) const {
+    return {{"integrator", integrator_name(scene.integrator)},
+            {"newton_tol", scene.implicit.newton_tol},
+            {"newton_max_allowed", scene.implicit.newton_max},
+            {"steps", steps},
+            {"newton_total", newton_total},
+            {"newton_max", newton_max},
+            {"newton_mean", steps ? static_cast<double>(newton_total) / steps : 0.0},
+            {"cg_total", cg_total},
+            {"cg_max", cg_max},
+            {"residual_max", residual_max}};
+  }
+};
+
 // The reason a step's report marks the run unstable, or empty.
 std::string failure_reason(const StepReport& r, Real J_floor) {
   if (r.non_finite >= 0)
@@ -145,6 +177,8 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   Parameters transfer_params = scene.transfer_params;
   auto stepper = make_stepper<Dim>(scene.transfer, scene.kernel, transfer_params);
   stepper->set_update_order(scene.update_order);
+  stepper->set_integrator(scene.integrator, scene.implicit);
+  const bool implicit = scene.integrator != Integrator::explicit_euler;
   stepper->prepare(s);  // one-time allocations, outside the timed steps
   auto reference = make_reference<Dim>(scene);
   // Also on resume: a reference keeps what it needs of the initial state (the
@@ -152,6 +186,12 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   if (reference) reference->initialize(s);
 
   std::vector<std::string> columns = kSeriesColumns;
+  // Implicit integrators: the Newton and CG iterations summed over the steps
+  // since the previous row, and the largest final relative residual among them.
+  if (implicit) {
+    for (const char* c : {"newton", "cg", "residual"}) columns.push_back(c);
+  }
+  ImplicitTally tally;
   const ExtraColumns<Dim> extra(s);
   for (const auto& c : extra.names()) columns.push_back(c);
   if (reference) {
@@ -159,6 +199,12 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   }
   auto sample = [&](const Diagnostics& d) {
     auto row = series_row(s.step, s.time, d);
+    if (implicit) {
+      row.push_back(static_cast<double>(tally.row_newton));
+      row.push_back(static_cast<double>(tally.row_cg));
+      row.push_back(tally.row_residual);
+      tally.next_row();
+    }
     for (double v : extra.values(s)) row.push_back(v);
     if (reference) {
       for (Real v : reference->sample(s, d)) row.push_back(v);
@@ -242,6 +288,15 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
     mon.v_max = report.v_max;
     progress.update(s.time / scene.t_end, s.step);
     reason = failure_reason(report, scene.J_floor);
+    if (const ImplicitStats* st = stepper->implicit_stats()) {
+      tally.add(*st);
+      if (!st->converged && reason.empty()) {
+        reason = fmt::format(
+            "the Newton solve did not converge at step {} ({} iterations of method.newton_max = "
+            "{}, residual {:.3g} of the step's initial one, tolerance {:.3g})",
+            s.step, st->newton, scene.implicit.newton_max, st->residual, scene.implicit.newton_tol);
+      }
+    }
     if (!reason.empty()) {
       status = "unstable";
       break;
@@ -334,6 +389,7 @@ RunOutcome run_dim(const Scene& scene, const std::filesystem::path& out_dir,
   j["J_elastic_min"] = mon.J_elastic_min;
   j["J_elastic_max"] = mon.J_elastic_max;
   if (frames.enabled()) j["frames"] = frames.summary();
+  if (implicit) j["implicit"] = tally.json(scene);
   if (reference) {
     j["error"] = reference->errors();
     j["measured"] = reference->measured();

@@ -72,6 +72,14 @@ void read_method(TableReader& top, Scene& s) {
     // Recorded in summaries like the other method keys, default included.
     method->insert("update_order", std::string(update_order_name(s.update_order)));
   }
+  // Not recorded in summaries when absent: an explicit run's summary stays as
+  // it was before the implicit integrators (the gate compares it exactly).
+  if (m.has("integrator")) s.integrator = parse_integrator(m.string("integrator"));
+  // The implicit integrators' Newton solve (integrators/implicit_impl.hpp).
+  s.implicit.newton_tol = m.number_or("newton_tol", s.implicit.newton_tol, Range::open(0, 1));
+  s.implicit.newton_max = m.integer_or("newton_max", s.implicit.newton_max, 1, 10000);
+  s.implicit.cg_tol = m.number_or("cg_tol", s.implicit.cg_tol, Range::open(0, 1));
+  s.implicit.cg_max = m.integer_or("cg_max", s.implicit.cg_max, 1, 1000000);
   m.finish();
   // A table named after a transfer holds that transfer's parameters ([flip] alpha = ...).
   // Tables of the other transfers are kept for switching with --transfer, but
@@ -419,6 +427,7 @@ void apply_overrides(toml::table& tree, const Overrides& o) {
   if (o.transfer) set_string("method.transfer", *o.transfer);
   if (o.kernel) set_string("method.kernel", *o.kernel);
   if (o.update_order) set_string("method.update_order", *o.update_order);
+  if (o.integrator) set_string("method.integrator", *o.integrator);
   if (o.t_end) set("time.t_end", fmt::format("{:.17g}", *o.t_end));
   if (o.cfl || o.dt) {
     if (auto* t = tree["time"].as_table()) {

@@ -61,7 +61,9 @@ struct Scene {
   int ppc = 2;      // particles per cell per axis
   std::string transfer, kernel;
   Parameters transfer_params;
-  UpdateOrder update_order = UpdateOrder::usl;  // stress-update order (core/stepper.hpp)
+  UpdateOrder update_order = UpdateOrder::usl;         // stress-update order (core/stepper.hpp)
+  Integrator integrator = Integrator::explicit_euler;  // integrators/integrator.hpp
+  ImplicitOptions implicit;  // the Newton solve's controls ([method] newton_tol, ...)
   Real t_end = 1;
   std::optional<Real> dt, cfl;  // exactly one is set
   Real output_interval = 0.1;
@@ -88,6 +90,7 @@ struct Overrides {
   std::optional<std::string> transfer = {};
   std::optional<std::string> kernel = {};
   std::optional<std::string> update_order = {};
+  std::optional<std::string> integrator = {};
   std::optional<std::string> model = {};
   std::optional<Real> cfl = {};
   std::optional<Real> dt = {};

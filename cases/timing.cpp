@@ -34,6 +34,7 @@ Pass one_pass(const Scene& scene) {
   Parameters transfer_params = scene.transfer_params;
   auto stepper = make_stepper<Dim>(scene.transfer, scene.kernel, transfer_params);
   stepper->set_update_order(scene.update_order);
+  stepper->set_integrator(scene.integrator, scene.implicit);
   stepper->prepare(s);
   auto reference = make_reference<Dim>(scene);
   if (reference) reference->initialize(s);

@@ -107,8 +107,8 @@ void check_out_dir(const std::filesystem::path& out) {
 }
 
 bool any_override(const Overrides& o) {
-  return o.dim || o.cells || o.ppc || o.transfer || o.kernel || o.update_order || o.model ||
-         o.cfl || o.dt || o.t_end || !o.set.empty();
+  return o.dim || o.cells || o.ppc || o.transfer || o.kernel || o.update_order || o.integrator ||
+         o.model || o.cfl || o.dt || o.t_end || !o.set.empty();
 }
 
 // `mpmtb run --resume DIR`: the checkpoint's scene and options, continued in DIR.

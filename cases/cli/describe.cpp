@@ -45,9 +45,15 @@ void describe_dim(const Scene& s) {
   fmt::print("  {:<28} {}\n", "method.transfer", s.transfer);
   fmt::print("  {:<28} {}\n", "method.kernel", s.kernel);
   Parameters transfer = s.transfer_params;
-  make_stepper<Dim>(s.transfer, s.kernel, transfer)->set_update_order(s.update_order);
+  {
+    auto stepper = make_stepper<Dim>(s.transfer, s.kernel, transfer);
+    stepper->set_update_order(s.update_order);
+    stepper->set_integrator(s.integrator, s.implicit);
+  }
   fmt::print("  {:<28} {}{}\n", "method.update_order", update_order_name(s.update_order),
              mark(s, "method.update_order"));
+  fmt::print("  {:<28} {}{}\n", "method.integrator", integrator_name(s.integrator),
+             mark(s, "method.integrator"));
   print_parameters(s.transfer, transfer);
   fmt::print("  {:<28} {:g}\n", "time.t_end", s.t_end);
   if (s.dt) fmt::print("  {:<28} {:g}  (fixed step)\n", "time.dt", *s.dt);

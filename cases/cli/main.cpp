@@ -47,6 +47,10 @@ void add_override_options(CLI::App& cmd, mpmtb::Overrides& o) {
                  fmt::format("stress-update order: {} (default: the scene's [method] "
                              "update_order, or usl)",
                              fmt::join(mpmtb::kUpdateOrderNames, ", ")));
+  cmd.add_option("--integrator", o.integrator,
+                 fmt::format("time integrator: {} (default: the scene's [method] integrator, "
+                             "or explicit; the implicit ones need a gradient-based transfer)",
+                             fmt::join(mpmtb::kIntegratorNames, ", ")));
   cmd.add_option("--model", o.model,
                  fmt::format("constitutive model for every material: {} (default: each "
                              "material's own)",

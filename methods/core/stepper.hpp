@@ -19,11 +19,13 @@
 
 #include <algorithm>
 #include <array>
+#include <memory>
 #include <string>
 #include <string_view>
 
 #include "core/errors.hpp"
 #include "core/state.hpp"
+#include "integrators/integrator.hpp"
 
 namespace mpmtb {
 
@@ -75,9 +77,22 @@ class Stepper {
   }
   UpdateOrder update_order() const { return order_; }
 
-  // One explicit step of size dt (symplectic Euler).
+  // The time integrator (integrators/integrator.hpp); throws InputError naming
+  // method.integrator for a transfer or order an implicit one cannot take.
+  void set_integrator(Integrator i, const ImplicitOptions& options = {});
+  Integrator integrator() const { return integrator_; }
+  // The last implicit step's Newton and CG figures (null for explicit).
+  const ImplicitStats* implicit_stats() const { return implicit_ ? &implicit_->stats() : nullptr; }
+
+  // One step of size dt: symplectic Euler (explicit), or the implicit solve.
   StepReport step(State<Dim>& s, Real dt) {
     StepReport r;
+    if (implicit_) {
+      implicit_->step(*this, s, dt, r);
+      s.time += dt;
+      ++s.step;
+      return r;
+    }
     switch (order_) {
       case UpdateOrder::usl:
         particles_to_grid(s, dt);
@@ -165,6 +180,31 @@ class Stepper {
   }
 
   UpdateOrder order_ = UpdateOrder::usl;
+  Integrator integrator_ = Integrator::explicit_euler;
+  std::unique_ptr<ImplicitSolve<Dim>> implicit_;
 };
+
+template <int Dim>
+void Stepper<Dim>::set_integrator(Integrator i, const ImplicitOptions& options) {
+  if (i == Integrator::explicit_euler) {
+    integrator_ = i;
+    implicit_.reset();
+    return;
+  }
+  const std::string name(integrator_name(i));
+  if (!gradient_based() || transfer_name() == "xpic") {
+    throw InputError(
+        "method.integrator: '" + name + "' is refused with transfer '" +
+        std::string(transfer_name()) +
+        "': the implicit solve needs a gradient-based transfer without a filter "
+        "of the old grid velocities; allowed: pic, flip, apic, aflip, asflip, polypic, tpic");
+  }
+  if (order_ != UpdateOrder::usl) {
+    throw InputError("method.integrator: '" + name +
+                     "' has its own stage order; method.update_order must be usl");
+  }
+  implicit_ = make_implicit_solve<Dim>(kernel_name(), i, options);
+  integrator_ = i;  // only once accepted: a refused integrator leaves the step as it was
+}
 
 }  // namespace mpmtb

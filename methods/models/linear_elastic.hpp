@@ -42,6 +42,10 @@ class LinearElastic final : public ModelBase<Dim, LinearElastic<Dim>> {
     return 2 * c_.mu * eps + c_.lambda * eps.trace() * Mat<Dim>::Identity();
   }
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const { return P(F, q) * F.transpose(); }
+  // dP = 2 mu sym(dF) + lambda tr(dF) I: constant in F (psi is quadratic).
+  Mat<Dim> dP(const Mat<Dim>&, const Mat<Dim>& dF, const Real*) const {
+    return c_.mu * (dF + dF.transpose()) + c_.lambda * dF.trace() * Mat<Dim>::Identity();
+  }
 
  private:
   ElasticConstants c_;

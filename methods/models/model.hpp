@@ -4,6 +4,7 @@
 // writes the batch loops once over the model's per-particle formulas.
 #pragma once
 
+#include <algorithm>
 #include <array>
 #include <memory>
 #include <span>
@@ -66,6 +67,12 @@ class ConstitutiveModel {
   // Per-particle formulas, for tests and diagnostics.
   virtual Real energy_density(const Mat<Dim>& F, const Real* q) const = 0;   // psi(F)
   virtual Mat<Dim> first_piola(const Mat<Dim>& F, const Real* q) const = 0;  // P = dpsi/dF
+  // dP = (dP/dF) : dF, the first elasticity tensor applied to dF, at the state q
+  // held fixed (the implicit integrators' Hessian, methods/integrators/). Exact
+  // for the elastic models; plasticity and damage give their elastic part at
+  // the current state (the return map runs after the implicit solve).
+  virtual Mat<Dim> first_piola_differential(const Mat<Dim>& F, const Mat<Dim>& dF,
+                                            const Real* q) const = 0;
   // Volume ratio of the total deformation: det F, or J_E J_P when F_p holds
   // only the elastic part (plasticity). Used for the reported volume and J range.
   virtual Real total_J(const Mat<Dim>& F, const Real* /*q*/) const { return F.determinant(); }
@@ -93,6 +100,22 @@ class ModelBase : public ConstitutiveModel<Dim> {
  public:
   Real energy_density(const Mat<Dim>& F, const Real* q) const override { return self().psi(F, q); }
   Mat<Dim> first_piola(const Mat<Dim>& F, const Real* q) const override { return self().P(F, q); }
+  // The model's own dP(F, dF, q) where it has one; otherwise the central
+  // difference of P along dF (step 1e-6 relative), second-order accurate: the
+  // fallback of the models whose stress derivative is not written out (sand,
+  // damage, aniso-damage), enough for Newton's direction, which the line
+  // search on the energy safeguards.
+  Mat<Dim> first_piola_differential(const Mat<Dim>& F, const Mat<Dim>& dF,
+                                    const Real* q) const override {
+    if constexpr (requires { self().dP(F, dF, q); }) {
+      return self().dP(F, dF, q);
+    } else {
+      const Real norm = dF.norm();
+      if (norm == 0) return Mat<Dim>::Zero();
+      const Real h = Real(1e-6) * std::max(Real(1), F.norm()) / norm;
+      return (self().P(F + h * dF, q) - self().P(F - h * dF, q)) / (2 * h);
+    }
+  }
   void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
                               std::vector<Mat<Dim>>& tauV) const override {
     const long n = static_cast<long>(ids.size());

@@ -48,6 +48,15 @@ class NeoHookean final : public ModelBase<Dim, NeoHookean<Dim>> {
     return c_.mu * (F * F.transpose() - Mat<Dim>::Identity()) +
            c_.lambda * logJ * Mat<Dim>::Identity();
   }
+  // The differential of P with d(F^-T) = -F^-T dF^T F^-T and d ln J = F^-T : dF
+  // (Bonet & Wood 2008, sec. 6.4.3):
+  //   dP = mu dF + (mu - lambda ln J) F^-T dF^T F^-T + lambda (F^-T : dF) F^-T.
+  Mat<Dim> dP(const Mat<Dim>& F, const Mat<Dim>& dF, const Real*) const {
+    const Mat<Dim> F_invT = F.inverse().transpose();
+    const Real logJ = std::log(F.determinant());
+    return c_.mu * dF + (c_.mu - c_.lambda * logJ) * F_invT * dF.transpose() * F_invT +
+           c_.lambda * (F_invT.cwiseProduct(dF)).sum() * F_invT;
+  }
 
  private:
   ElasticConstants c_;

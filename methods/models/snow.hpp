@@ -107,6 +107,11 @@ class Snow final : public ModelBase<Dim, Snow<Dim>> {
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
     return hardening(q[kJP]) * fixed_corotated_tau<Dim>(F, c_.mu, c_.lambda);
   }
+  // The elastic part at the current J_P (semi-implicit, Stomakhin et al. 2013,
+  // sec. 5 and 9: the return map follows the solve).
+  Mat<Dim> dP(const Mat<Dim>& F, const Mat<Dim>& dF, const Real* q) const {
+    return hardening(q[kJP]) * fixed_corotated_dP<Dim>(F, dF, c_.mu, c_.lambda);
+  }
 
   // The return map of one particle: F is the trial elastic part on entry and
   // the clamped elastic part on exit. A trial state inside the elastic region

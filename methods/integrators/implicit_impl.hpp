@@ -1,0 +1,647 @@
+// The implicit step (integrators/integrator.hpp) for one dimension and kernel.
+// Included only by integrators/implicit_*d.cpp, which instantiate it once per
+// kernel: the solve works on the grid and the particles' F, never on the
+// transfer, so it is compiled once per dimension x kernel, not per transfer.
+//
+// Incremental potential (Gast et al. 2015, eq. 6-8): after P2G (mass m_i and
+// the transfer's momentum p_i, v_i^n = p_i / m_i), the grid velocities v of
+// the step minimise
+//   E(v) = sum_i m_i / 2 |v_i - v~_i|^2 + sum_p V0_p psi(F_p(v)),
+//   F_p(v) = (I + h sum_i (b_i + v_i) grad w_ip^T) F_p^n,
+// whose stationarity m_i (v_i - v~_i) = -h dPsi/dx_i is the momentum balance
+// of the scheme:
+//   backward Euler: h = dt, b = 0, v~ = v^n + dt g;
+//     the grid moves by dt v^n+1 and the force is taken at the end of the step.
+//   Newmark, beta = 1/4, gamma = 1/2 (the trapezoidal rule): h = dt/2,
+//     b = v^n, v~ = v^n + dt g + dt/2 f(F^n) / m: the grid moves by
+//     dt (v^n + v^n+1)/2 and m (v^n+1 - v^n) = dt/2 (f^n + f^n+1).
+//     Energy: for a quadratic psi, Psi(F^n+1) - Psi(F^n) = (P^n + P^n+1)/2 :
+//     (F^n+1 - F^n) = -dt/2 (v^n + v^n+1) . (f^n + f^n+1)/2, while the kinetic
+//     energy changes by m (v^n+1 - v^n) . (v^n+1 + v^n)/2 = the same with the
+//     opposite sign: the grid energy is kept exactly (to the solver's
+//     tolerance). For one mode x'' = -omega^2 x the step's amplification is
+//     A = (1 - (omega dt/2)^2 + i omega dt) / (1 + (omega dt/2)^2) with
+//     |A|^2 = ((1 - z^2)^2 + 4 z^2) / (1 + z^2)^2 = 1, z = omega dt / 2:
+//     no growth or decay at any dt, a phase error of O((omega dt)^3) per step.
+//     (Backward Euler: A = 1 / (1 - i omega dt), |A| = 1 / sqrt(1 + (omega dt)^2).)
+// Newton's method on E: the Hessian-vector product
+//   H d = m d + h^2 sum_p V0_p (dP/dF : dF_p) F_p^nT grad w_ip,
+//   dF_p = sum_i d_i grad w_ip^T F_p^n,
+// with each particle's dP/dF (a Dim^2 x Dim^2 block, built from the model's
+// first_piola_differential) projected to positive semi-definite by clamping
+// its negative eigenvalues (Teran, Sifakis, Irving & Fedkiw 2005, "Robust
+// quasistatic finite elements and flesh simulation", sec. 5, per particle
+// instead of per element), so that every direction descends. The linear
+// systems are solved matrix-free by our own Jacobi-preconditioned conjugate
+// gradients (below): the operator acts on the grid's Vec<Dim> arrays over the
+// active nodes with the constraints folded in, which Eigen's CG would need a
+// wrapper type and a flattening copy for, for no gain. An inexact Newton
+// forcing term (|r| <= min(cg_tol, |g|/|g_0|) |g|) and a backtracking (Armijo)
+// line search on E. Converged when |g| <= newton_tol |g_0|, g_0 the gradient
+// at the step's start (v = v~), or below a round-off floor.
+//
+// Constraints act inside the solve: the unknowns are the velocities of the
+// active nodes; a pinned node (v = 0), a node inside a collider (its velocity
+// set by the collider, probed at the start of the step, then held: Dirichlet)
+// and the components a wall constrains on its face (sticky: all, slip: the
+// normal one; separate: the normal one where v~ presses into the wall) are
+// masked out, and the ghosts beyond sticky and slip walls follow their mirror
+// nodes, v_ghost = R v_mirror (boundary/walls.hpp): the velocity field is
+// v = T u + c, and the solve uses T^T on gradients (the walls' fold).
+// Plasticity and damage: F_p^n is the elastic part after the last return map
+// and psi is evaluated at the current internal state; the return map runs
+// after the solve (the semi-implicit convention of Stomakhin et al. 2013,
+// "A material point method for snow simulation", sec. 9).
+#pragma once
+
+#include <Eigen/Eigenvalues>
+#include <algorithm>
+#include <cmath>
+#include <cstdint>
+#include <limits>
+#include <string>
+#include <vector>
+
+#include "core/stencil.hpp"
+#include "core/stepper.hpp"
+#include "integrators/integrator.hpp"
+#include "kernels/all.hpp"
+
+namespace mpmtb {
+
+template <int Dim, class Kernel>
+class ImplicitSolveT final : public ImplicitSolve<Dim> {
+  using V = std::vector<Vec<Dim>>;
+  using StencilT = Stencil<Dim, Kernel>;
+  static constexpr int kD2 = Dim * Dim;
+  using Block = Eigen::Matrix<Real, kD2, kD2>;
+  using Flat = Eigen::Matrix<Real, kD2, 1>;
+  using ImplicitSolve<Dim>::stats_;
+
+ public:
+  ImplicitSolveT(Integrator i, const ImplicitOptions& o)
+      : newmark_(i == Integrator::newmark), opt_(o) {}
+
+  void step(Stepper<Dim>& stepper, State<Dim>& s, Real dt, StepReport& report) override {
+    setup(stepper, s, dt);
+    V u = solve();
+    finish(stepper, s, dt, u, report);
+  }
+
+  // P2G and the step's objective, without solving (also for tests).
+  void setup(Stepper<Dim>& stepper, State<Dim>& s, Real dt) override {
+    s_ = &s;
+    h_ = newmark_ ? dt / 2 : dt;
+    Grid<Dim>& g = s.grid;
+    const Particles<Dim>& P = s.particles;
+    const long n = static_cast<long>(P.size());
+    stepper.scatter_momentum(s);  // m, p (the transfer's own), pinned nodes; f = 0
+    // The active nodes (the box P2G swept).
+    nodes_.clear();
+    for (long r = 0; r < g.active_rows(); ++r) {
+      const auto [first, count] = g.active_row(r);
+      for (long i = first; i < first + count; ++i) nodes_.push_back(i);
+    }
+    const std::size_t N = g.size();
+    for (V* f : {&target_, &mask_, &fixed_, &vn_, &base_}) f->assign(N, Vec<Dim>::Zero());
+    mass_.assign(N, 0);
+    collider_.assign(N, 0);
+    stencils_.clear();
+    stencils_.reserve(P.size());
+    // Deformed-domain kernels (cpGIMP, CPDI) take F_p at the step's start, as P2G did.
+    for (long p = 0; p < n; ++p) stencils_.emplace_back(P.x[p], P.F[p], g.geo);
+    Fn_ = P.F;
+    F_ = P.F;
+    K_.resize(P.size());
+    // Body forces into f before the walls fold it with m and p.
+    if (s.body_force) {
+      for (long p = 0; p < n; ++p) {
+        const Vec<Dim> mb = P.m[p] * s.body_force(P, static_cast<int>(p), s.time);
+        stencils_[p].for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+          g.f[node] += w * mb;
+        });
+      }
+    }
+    s.walls.fold(g);
+    for (const long i : nodes_) {
+      if (g.m[i] > 0) {
+        mass_[i] = g.m[i];
+        vn_[i] = g.p[i] / g.m[i];
+        g.v_old[i] = vn_[i];  // what FLIP-like transfers read back
+        target_[i] = vn_[i] + dt * s.gravity + (dt / g.m[i]) * g.f[i];
+        mask_[i].setOnes();
+      }
+    }
+    build_wall_constraints(g);
+    for (const long i : nodes_) {
+      if (g.pinned[i]) mask_[i].setZero();
+    }
+    if (!s.colliders.empty()) probe_colliders(g, s.time + dt);
+    // v^n with the constraints (Newmark's b, and the grid energy before the step).
+    vn_ = expand(vn_, true);
+    if (newmark_) {
+      // v~ += dt/2 f(F^n) / m, f(F^n) = -sum_p V0 P(F^n) F^nT grad w (folded;
+      // with b = 0 still, v = 0 gives F^n).
+      V div(N, Vec<Dim>::Zero());
+      stress_divergence(zeros(), div);
+      fold_ghosts(div);
+      for (const long i : nodes_) {
+        if (mass_[i] > 0) target_[i] -= (dt / 2 / mass_[i]) * div[i];
+      }
+      base_ = vn_;
+    }
+    start_.assign(N, Vec<Dim>::Zero());
+    for (const long i : nodes_) start_[i] = mask_[i].cwiseProduct(target_[i]);
+  }
+
+  // The objective at unknowns u (values on the masked components are ignored).
+  Real energy(const V& u) override {
+    const V v = expand(u, true);
+    Real kinetic = 0;
+    for (const long i : nodes_) kinetic += Real(0.5) * mass_[i] * (v[i] - target_[i]).squaredNorm();
+    return kinetic + strain_energy(v);
+  }
+
+  // g = T^T dE/dv: the reduced gradient (zero on masked components).
+  void gradient(const V& u, V& out) override {
+    const V v = expand(u, true);
+    out.assign(v.size(), Vec<Dim>::Zero());
+    stress_divergence(v, out);
+    for (const long i : nodes_) out[i] *= h_;
+    fold_ghosts(out);
+    for (const long i : nodes_) {
+      out[i] = mask_[i].cwiseProduct(out[i] + mass_[i] * (v[i] - target_[i]));
+    }
+  }
+
+  // H d at unknowns u: the particles' blocks dP/dF at F_p(u), projected to
+  // positive semi-definite when `project`.
+  void hessian_times(const V& u, const V& d, V& out, bool project) override {
+    update_F(expand(u, true));
+    build_blocks(project);
+    apply_hessian(d, out);
+  }
+
+  const V& start() const override { return start_; }
+  const std::vector<long>& active_nodes() const override { return nodes_; }
+
+ private:
+  struct Link {
+    long ghost, mirror;
+    int axis;  // slip: the normal axis; -1: sticky (R = -I)
+  };
+
+  static Vec<Dim> reflect(const Link& l, const Vec<Dim>& v) {
+    if (l.axis < 0) return -v;
+    Vec<Dim> r = v;
+    r[l.axis] = -r[l.axis];
+    return r;
+  }
+
+  V zeros() const { return V(mass_.size(), Vec<Dim>::Zero()); }
+
+  // v = T u (+ c): the masked unknowns, the prescribed values, then the ghosts
+  // from their mirrors in the order of Walls::apply.
+  V expand(const V& u, bool with_fixed) const {
+    V v(mass_.size(), Vec<Dim>::Zero());
+    for (const long i : nodes_) {
+      v[i] = mask_[i].cwiseProduct(u[i]);
+      if (with_fixed) v[i] += fixed_[i];
+    }
+    for (const Link& l : links_) v[l.ghost] = reflect(l, v[l.mirror]);
+    return v;
+  }
+  // r <- the transpose of the ghost copies (the walls' fold), in reverse order.
+  void fold_ghosts(V& r) const {
+    for (auto it = links_.rbegin(); it != links_.rend(); ++it) {
+      r[it->mirror] += reflect(*it, r[it->ghost]);
+      r[it->ghost].setZero();
+    }
+  }
+
+  // The faces' constraints, in the order of Walls::apply (boundary/walls.cpp).
+  void build_wall_constraints(const Grid<Dim>& g) {
+    links_.clear();
+    constexpr int pad = GridGeometry<Dim>::pad;
+    const GridGeometry<Dim>& geo = g.geo;
+    for (int axis = 0; axis < Dim; ++axis) {
+      const long stride = geo.strides()[axis];
+      const long block = stride * geo.nodes(axis);
+      const long outer = geo.node_count() / block;
+      const int mirrored = std::min(pad, geo.cells[axis]);
+      for (int side = 0; side < 2; ++side) {
+        const Wall w = s_->walls.face[2 * axis + side];
+        if (w == Wall::free) continue;
+        const int outward = side == 0 ? -1 : 1;
+        const long out = outward * stride;
+        const int face_index = side == 0 ? pad : pad + geo.cells[axis];
+        for (long o = 0; o < outer; ++o) {
+          for (long st = 0; st < stride; ++st) {
+            const long face = o * block + face_index * stride + st;
+            constrain(w, axis, outward, face);
+            for (int k = 1; k <= pad; ++k) {
+              const long ghost = face + k * out;
+              if (g.m[ghost] <= 0) continue;
+              if (w != Wall::separate && k <= mirrored) {
+                links_.push_back({ghost, face - k * out, w == Wall::sticky ? -1 : axis});
+                mask_[ghost].setZero();
+                mass_[ghost] = 0;  // folded into the mirror
+              } else {
+                constrain(w, axis, outward, ghost);
+              }
+            }
+          }
+        }
+      }
+    }
+  }
+  void constrain(Wall w, int axis, int outward, long node) {
+    if (w == Wall::sticky) {
+      mask_[node].setZero();
+    } else if (w == Wall::slip || (w == Wall::separate && target_[node][axis] * outward > 0)) {
+      mask_[node][axis] = 0;
+    }
+  }
+
+  // Nodes a collider acts on (at v~) are held at the velocity it gives them.
+  void probe_colliders(Grid<Dim>& g, Real t) {
+    for (const long i : nodes_) g.v[i] = mask_[i].cwiseProduct(target_[i]);
+    const V before(g.v);
+    Vec3 impulse = Vec3::Zero();
+    Real work = 0;
+    s_->colliders.apply(g, t, impulse, work);
+    for (const long i : nodes_) {
+      if (g.v[i] != before[i]) {
+        mask_[i].setZero();
+        fixed_[i] = g.v[i];
+        collider_[i] = 1;
+      }
+      g.v[i].setZero();
+    }
+  }
+
+  // F_p = (I + h sum_i (b_i + v_i) grad w_ip^T) F_p^n for every particle.
+  void update_F(const V& v) {
+    const Grid<Dim>& g = s_->grid;
+    const long n = static_cast<long>(Fn_.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      Mat<Dim> G = Mat<Dim>::Zero();
+      stencils_[p].for_each_node(g.geo,
+                                 [&](long node, Real, const Vec<Dim>& grad, const Vec<Dim>&) {
+                                   G += (base_[node] + v[node]) * grad.transpose();
+                                 });
+      F_[p] = (Mat<Dim>::Identity() + h_ * G) * Fn_[p];
+    }
+  }
+
+  Real strain_energy(const V& v) {
+    update_F(v);
+    const Particles<Dim>& P = s_->particles;
+    Real sum = 0;
+    for (std::size_t p = 0; p < F_.size(); ++p) {
+      sum += P.V0[p] * s_->materials[P.material[p]]->energy_density(F_[p], P.state_of(p));
+    }
+    return std::isfinite(sum) ? sum : std::numeric_limits<Real>::infinity();
+  }
+
+  // out_i += sum_p V0_p P(F_p(v)) F_p^nT grad w_ip (the negative internal force).
+  void stress_divergence(const V& v, V& out) {
+    update_F(v);
+    const Particles<Dim>& P = s_->particles;
+    const long n = static_cast<long>(F_.size());
+    Q_.resize(F_.size());
+    Real noise = 0;
+#pragma omp parallel for schedule(static) reduction(+ : noise) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      const Mat<Dim> Pp = s_->materials[P.material[p]]->first_piola(F_[p], P.state_of(p));
+      Q_[p] = P.V0[p] * Pp * Fn_[p].transpose();
+      const ConstitutiveModel<Dim>& model = *s_->materials[P.material[p]];
+      const Real c = model.wave_speed();
+      noise += P.V0[p] * (Pp.norm() + model.density() * c * c * F_[p].norm()) * F_[p].norm();
+    }
+    psi_noise_ = std::numeric_limits<Real>::epsilon() * noise;
+    scatter_Q(out);
+  }
+  void scatter_Q(V& out) const {
+    const Grid<Dim>& g = s_->grid;
+    for (std::size_t p = 0; p < F_.size(); ++p) {
+      stencils_[p].for_each_node(g.geo, [&](long node, Real, const Vec<Dim>& grad,
+                                            const Vec<Dim>&) { out[node] += Q_[p] * grad; });
+    }
+  }
+
+  // Each particle's dP/dF at F_p as a Dim^2 x Dim^2 matrix on column-major
+  // vec(dF), optionally projected to positive semi-definite.
+  void build_blocks(bool project) {
+    const Particles<Dim>& P = s_->particles;
+    const long n = static_cast<long>(F_.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      const ConstitutiveModel<Dim>& model = *s_->materials[P.material[p]];
+      Block K;
+      for (int j = 0; j < kD2; ++j) {
+        Mat<Dim> E = Mat<Dim>::Zero();
+        E(j % Dim, j / Dim) = 1;
+        const Mat<Dim> dP = model.first_piola_differential(F_[p], E, P.state_of(p));
+        K.col(j) = Eigen::Map<const Flat>(dP.data());
+      }
+      if (project) {
+        const Block Ks = Real(0.5) * (K + K.transpose());
+        Eigen::SelfAdjointEigenSolver<Block> eig(Ks);
+        if (eig.eigenvalues().minCoeff() < 0) {
+          K = eig.eigenvectors() * eig.eigenvalues().cwiseMax(Real(0)).asDiagonal() *
+              eig.eigenvectors().transpose();
+        }
+      }
+      K_[p] = K;
+    }
+  }
+
+  // out = M d + T^T h^2 sum_p V0 (K_p : dF_p) F^nT grad w (masked), d masked.
+  void apply_hessian(const V& d, V& out) {
+    const Grid<Dim>& g = s_->grid;
+    const V dv = expand(d, false);
+    const Particles<Dim>& P = s_->particles;
+    const long n = static_cast<long>(F_.size());
+    Q_.resize(F_.size());
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      Mat<Dim> G = Mat<Dim>::Zero();
+      stencils_[p].for_each_node(g.geo, [&](long node, Real, const Vec<Dim>& grad,
+                                            const Vec<Dim>&) { G += dv[node] * grad.transpose(); });
+      const Mat<Dim> dF = h_ * G * Fn_[p];
+      Mat<Dim> dP;
+      Eigen::Map<Flat>(dP.data()) = K_[p] * Eigen::Map<const Flat>(dF.data());
+      Q_[p] = (h_ * P.V0[p]) * dP * Fn_[p].transpose();
+    }
+    out.assign(mass_.size(), Vec<Dim>::Zero());
+    scatter_Q(out);
+    fold_ghosts(out);
+    for (const long i : nodes_) out[i] = mask_[i].cwiseProduct(out[i] + mass_[i] * d[i]);
+  }
+
+  // The Jacobi preconditioner: 1 / diag(H) on the free components.
+  void build_preconditioner() {
+    const Grid<Dim>& g = s_->grid;
+    const Particles<Dim>& P = s_->particles;
+    V diag(mass_.size(), Vec<Dim>::Zero());
+    for (std::size_t p = 0; p < F_.size(); ++p) {
+      const Mat<Dim> FnT = Fn_[p].transpose();
+      stencils_[p].for_each_node(
+          g.geo, [&](long node, Real, const Vec<Dim>& grad, const Vec<Dim>&) {
+            const Vec<Dim> b = h_ * (FnT * grad);  // dF = e_a b^T for d = e_a at the node
+            for (int a = 0; a < Dim; ++a) {
+              Real sum = 0;
+              for (int c = 0; c < Dim; ++c) {
+                for (int e = 0; e < Dim; ++e) sum += b[c] * b[e] * K_[p](a + Dim * c, a + Dim * e);
+              }
+              diag[node][a] += h_ * P.V0[p] * sum;
+            }
+          });
+    }
+    for (auto it = links_.rbegin(); it != links_.rend(); ++it) {
+      diag[it->mirror] += diag[it->ghost];
+    }
+    inv_diag_.assign(mass_.size(), Vec<Dim>::Zero());
+    for (const long i : nodes_) {
+      for (int a = 0; a < Dim; ++a) {
+        const Real d = diag[i][a] + mass_[i];
+        inv_diag_[i][a] = mask_[i][a] > 0 && d > 0 ? 1 / d : 0;
+      }
+    }
+  }
+
+  Real dot(const V& a, const V& b) const {
+    Real s = 0;
+    for (const long i : nodes_) s += a[i].dot(b[i]);
+    return s;
+  }
+
+  // Preconditioned CG on H x = b to |r| <= tol; returns the iterations.
+  long conjugate_gradients(const V& b, V& x, Real tol) {
+    const std::size_t N = mass_.size();
+    x.assign(N, Vec<Dim>::Zero());
+    V r = b, z(N, Vec<Dim>::Zero()), q(N, Vec<Dim>::Zero()), Aq;
+    for (const long i : nodes_) z[i] = inv_diag_[i].cwiseProduct(r[i]);
+    q = z;
+    Real rz = dot(r, z);
+    long k = 0;
+    for (; k < opt_.cg_max && std::sqrt(dot(r, r)) > tol; ++k) {
+      apply_hessian(q, Aq);
+      const Real qAq = dot(q, Aq);
+      if (!(qAq > 0)) break;  // not positive definite along q (cannot happen when projected)
+      const Real alpha = rz / qAq;
+      for (const long i : nodes_) {
+        x[i] += alpha * q[i];
+        r[i] -= alpha * Aq[i];
+        z[i] = inv_diag_[i].cwiseProduct(r[i]);
+      }
+      const Real rz_new = dot(r, z);
+      const Real beta = rz_new / rz;
+      rz = rz_new;
+      for (const long i : nodes_) q[i] = z[i] + beta * q[i];
+    }
+    return k;
+  }
+
+  // Newton's method from v~; fills stats_.
+  V solve() {
+    stats_ = ImplicitStats{};
+    V u = start_;
+    Real E = energy(u);
+    if (!std::isfinite(E)) {
+      // v~ inverts a particle: start from the velocities that keep F^n.
+      for (const long i : nodes_) u[i] = -base_[i];
+      E = energy(u);
+    }
+    V grad, d, trial;
+    gradient(u, grad);
+    const Real g0 = std::sqrt(dot(grad, grad));
+    // The round-off floor of |g|: the momenta it sums, and the stresses, each
+    // known to about eps times the stiffness rho c^2 (F is I + O(eps) at rest),
+    // times h V0 |grad w| ~ h V0 2 Dim / dx per particle.
+    Real scale = 0;
+    for (const long i : nodes_) scale += mass_[i] * (target_[i].norm() + base_[i].norm());
+    const Particles<Dim>& P = s_->particles;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      const ConstitutiveModel<Dim>& model = *s_->materials[P.material[p]];
+      const Real c = model.wave_speed();
+      scale += h_ * P.V0[p] * model.density() * c * c * (2 * Dim * s_->grid.geo.inv_dx) *
+               std::max(Real(1), Fn_[p].squaredNorm());
+    }
+    const Real floor = 64 * std::numeric_limits<Real>::epsilon() * std::max(scale, g0);
+    Real gnorm = g0;
+    while (gnorm > opt_.newton_tol * g0 && gnorm > floor) {
+      if (stats_.newton >= opt_.newton_max) {
+        stats_.converged = false;
+        break;
+      }
+      ++stats_.newton;
+      update_F(expand(u, true));
+      build_blocks(true);
+      build_preconditioner();
+      V rhs = grad;
+      for (const long i : nodes_) rhs[i] = -grad[i];
+      const Real eta = std::min(opt_.cg_tol, gnorm / g0);
+      const Real cg_tol = std::max(eta * gnorm, Real(0.1) * opt_.newton_tol * g0);
+      stats_.cg += conjugate_gradients(rhs, d, cg_tol);
+      Real slope = dot(grad, d);
+      if (!(slope < 0)) {  // no descent (CG stopped at once): the preconditioned gradient
+        for (const long i : nodes_) d[i] = -inv_diag_[i].cwiseProduct(grad[i]);
+        slope = dot(grad, d);
+      }
+      // Backtracking (Armijo) on E. Near the solution the decrease a Newton step
+      // promises, |slope|/2, falls below the round-off of E itself (a sum of
+      // terms of size E): a full step whose E is level with E to round-off is
+      // then accepted when it reduces |g|, so that the last iterations are
+      // judged by the gradient, which keeps its relative accuracy.
+      Real alpha = 1, E_new = E;
+      bool accepted = false;
+      V grad_new;
+      for (int ls = 0; ls < 40; ++ls, alpha *= Real(0.5)) {
+        trial = u;
+        for (const long i : nodes_) trial[i] += alpha * d[i];
+        E_new = energy(trial);
+        if (!std::isfinite(E_new)) continue;
+        if (E_new <= E + Real(1e-4) * alpha * slope) {
+          accepted = true;
+          break;
+        }
+        // The round-off of E: eps |E|, and per particle eps V0 (|P| + rho c^2 |F|) |F|:
+        // psi(F) is known to P : dF with |dF| ~ eps |F| where F - I cancels at
+        // small strain, and its terms of size rho c^2 |F|^2 cancel near rest
+        // (neo-Hookean's mu/2 tr(F^T F) against mu ln J).
+        const Real noise = 64 * (std::numeric_limits<Real>::epsilon() * std::abs(E) + psi_noise_);
+        if (ls == 0 && E_new - E <= noise) {
+          gradient(trial, grad_new);
+          if (dot(grad_new, grad_new) < gnorm * gnorm) {
+            accepted = true;
+            break;
+          }
+        }
+      }
+      if (!accepted) {
+        stats_.converged = false;
+        break;
+      }
+      u.swap(trial);
+      E = E_new;
+      gradient(u, grad);
+      gnorm = std::sqrt(dot(grad, grad));
+    }
+    // 0 where v~ already solves the step to round-off (free fall, rest).
+    stats_.residual = g0 > floor ? gnorm / g0 : 0;
+    if (!std::isfinite(gnorm)) stats_.converged = false;
+    return u;
+  }
+
+  // The solved velocities to the grid, then G2P and the return maps.
+  void finish(Stepper<Dim>& stepper, State<Dim>& s, Real dt, const V& u, StepReport& report) {
+    Grid<Dim>& g = s.grid;
+    const V v = expand(u, true);
+    // Grid energy before and after (kinetic with P2G's constrained velocities).
+    V grad_full = zeros();
+    stress_divergence(v, grad_full);
+    Real after = strain_energy(v), before = strain_energy_at_Fn();
+    for (const long i : nodes_) {
+      after += Real(0.5) * mass_[i] * v[i].squaredNorm();
+      before += Real(0.5) * mass_[i] * vn_[i].squaredNorm();
+    }
+    stats_.grid_energy = before;
+    stats_.grid_energy_change = after - before;
+    // Reactions of the pinned nodes and colliders: the constraint impulse
+    // m_i (v_i - v~_i) + h dPsi/dv_i at the nodes they hold.
+    for (const long i : nodes_) grad_full[i] *= h_;
+    fold_ghosts(grad_full);
+    Vec3 pin = Vec3::Zero(), col = Vec3::Zero();
+    Real work = 0;
+    for (const long i : nodes_) {
+      const Vec<Dim> J = mass_[i] * (v[i] - target_[i]) + grad_full[i];
+      if (collider_[i]) {
+        col += to3<Dim>(J);
+        work += J.dot(v[i]);
+      } else if (g.pinned[i]) {
+        pin += to3<Dim>(J);
+      }
+    }
+    s.pin_impulse += pin;
+    s.collider_impulse += col;
+    s.collider_work += work;
+
+    const Particles<Dim>& P = s.particles;
+    std::vector<Vec<Dim>> shift;
+    if (newmark_) {
+      // F^n+1 = (I + dt (v^n + v^n+1)/2 grad w^T) F^n; x^n+1 = x^n + dt (v^n + v^n+1)/2,
+      // the transfer's G2P moving by dt v^n+1 and the difference added after.
+      for (const long i : nodes_) g.v[i] = Real(0.5) * (base_[i] + v[i]);
+      shift.assign(P.size(), Vec<Dim>::Zero());
+      for (std::size_t p = 0; p < P.size(); ++p) {
+        stencils_[p].for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+          shift[p] += (dt / 2 * w) * (base_[node] - v[node]);
+        });
+      }
+    } else {
+      for (const long i : nodes_) g.v[i] = v[i];
+    }
+    const StepReport deformed = stepper.update_deformation(s, dt);
+    for (const long i : nodes_) g.v[i] = v[i];
+    report = stepper.move_particles(s, dt);
+    if (newmark_) {
+      for (std::size_t p = 0; p < P.size(); ++p) s.particles.x[p] += shift[p];
+    }
+    report.J_min = deformed.J_min;
+    report.J_max = deformed.J_max;
+    if (deformed.non_finite >= 0) {
+      report.non_finite = report.non_finite < 0 ? deformed.non_finite
+                                                : std::min(report.non_finite, deformed.non_finite);
+    }
+    stepper.nonlocal_update(s);
+    stepper.constitutive_update(s, dt);
+  }
+  Real strain_energy_at_Fn() const {
+    const Particles<Dim>& P = s_->particles;
+    Real sum = 0;
+    for (std::size_t p = 0; p < Fn_.size(); ++p) {
+      sum += P.V0[p] * s_->materials[P.material[p]]->energy_density(Fn_[p], P.state_of(p));
+    }
+    return sum;
+  }
+
+  bool newmark_;
+  ImplicitOptions opt_;
+  State<Dim>* s_ = nullptr;
+  Real h_ = 0;
+  Real psi_noise_ = 0;       // eps sum_p V0 |P| |F| at the last gradient
+  std::vector<long> nodes_;  // the active nodes
+  std::vector<Real> mass_;   // m_i, folded; 0 at ghosts that follow a mirror
+  V target_;                 // v~
+  V mask_;                   // 1: free component, 0: prescribed
+  V fixed_;                  // the prescribed values (colliders)
+  V vn_;                     // P2G's v^n with the constraints
+  V base_;                   // b: v^n for Newmark, 0 for backward Euler
+  V start_;                  // the initial guess
+  V inv_diag_;
+  std::vector<std::uint8_t> collider_;
+  std::vector<Link> links_;
+  std::vector<StencilT> stencils_;
+  std::vector<Mat<Dim>> Fn_, F_, Q_;
+  std::vector<Block, Eigen::aligned_allocator<Block>> K_;
+};
+
+template <int Dim>
+std::unique_ptr<ImplicitSolve<Dim>> make_implicit_solve(std::string_view kernel,
+                                                        Integrator integrator,
+                                                        const ImplicitOptions& options) {
+  std::unique_ptr<ImplicitSolve<Dim>> solve;
+  AllKernels::for_each([&]<class K>() {
+    if (!solve && K::name == kernel)
+      solve = std::make_unique<ImplicitSolveT<Dim, K>>(integrator, options);
+  });
+  if (!solve)
+    throw InputError("method.integrator: no implicit solve for kernel '" + std::string(kernel) +
+                     "'");
+  return solve;
+}
+
+}  // namespace mpmtb
