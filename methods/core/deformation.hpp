@@ -1,8 +1,8 @@
 // The deformation-gradient update of G2P, shared by every transfer:
 //   F_p^{n+1} = (I + dt L_p) F_p^n,
-// L_p the particle's velocity gradient (sum_i v_i grad w_ip^T, or MLS-MPM's C_p):
-// Sulsky, Chen & Schreyer 1994, "A particle method for history-dependent
-// materials", CMAME 118, eq. 31; Jiang et al. 2016 (SIGGRAPH course), eq. 181.
+// L_p the particle's velocity gradient (sum_i v_i grad w_ip^T, or MLS-MPM's C_p,
+// Hu et al. 2018, eq. 17): the update of Sulsky, Chen & Schreyer 1994, "A
+// particle method for history-dependent materials", CMAME 118.
 // Evaluated as F + dt L F column by column in SIMD registers, one axis per lane:
 // written with Eigen's 3x3 product it went through a temporary on the stack that
 // was stored in scalars and read back in packets, which stalled G2P on store
