@@ -1,8 +1,5 @@
-// The implicit step (integrators/integrator.hpp) for one dimension and kernel.
-// Included only by integrators/implicit_*d.cpp, which instantiate it once per
-// kernel: the solve works on the grid and the particles' F, never on the
-// transfer, so it is compiled once per dimension x kernel, not per transfer.
-//
+// The implicit step (integrators/integrator.hpp), instantiated once per dimension
+// x kernel by integrators/implicit_*d.cpp: it never depends on the transfer.
 // Incremental potential (Gast et al. 2015, eq. 6-8): after P2G (mass m_i and
 // the transfer's momentum p_i, v_i^n = p_i / m_i), the grid velocities v of
 // the step minimise
@@ -15,30 +12,8 @@
 //   Newmark, beta = 1/4, gamma = 1/2 (the trapezoidal rule): h = dt/2,
 //     b = v^n, v~ = v^n + dt g + dt/2 f(F^n) / m: the grid moves by
 //     dt (v^n + v^n+1)/2 and m (v^n+1 - v^n) = dt/2 (f^n + f^n+1).
-//     Energy: for a quadratic psi, Psi(F^n+1) - Psi(F^n) = (P^n + P^n+1)/2 :
-//     (F^n+1 - F^n) = -dt/2 (v^n + v^n+1) . (f^n + f^n+1)/2, while the kinetic
-//     energy changes by m (v^n+1 - v^n) . (v^n+1 + v^n)/2 = the same with the
-//     opposite sign: the grid energy is kept exactly (to the solver's
-//     tolerance). For one mode x'' = -omega^2 x the step's amplification is
-//     A = (1 - (omega dt/2)^2 + i omega dt) / (1 + (omega dt/2)^2) with
-//     |A|^2 = ((1 - z^2)^2 + 4 z^2) / (1 + z^2)^2 = 1, z = omega dt / 2:
-//     no growth or decay at any dt, a phase error of O((omega dt)^3) per step.
-//     (Backward Euler: A = 1 / (1 - i omega dt), |A| = 1 / sqrt(1 + (omega dt)^2).)
-// Newton's method on E: the Hessian-vector product
-//   H d = m d + h^2 sum_p V0_p (dP/dF : dF_p) F_p^nT grad w_ip,
-//   dF_p = sum_i d_i grad w_ip^T F_p^n,
-// with each particle's dP/dF (a Dim^2 x Dim^2 block, built from the model's
-// first_piola_differential) projected to positive semi-definite by clamping
-// its negative eigenvalues (Teran, Sifakis, Irving & Fedkiw 2005, "Robust
-// quasistatic finite elements and flesh simulation", sec. 5, per particle
-// instead of per element), so that every direction descends. The linear
-// systems are solved matrix-free by our own Jacobi-preconditioned conjugate
-// gradients (below): the operator acts on the grid's Vec<Dim> arrays over the
-// active nodes with the constraints folded in, which Eigen's CG would need a
-// wrapper type and a flattening copy for, for no gain. An inexact Newton
-// forcing term (|r| <= min(cg_tol, |g|/|g_0|) |g|) and a backtracking (Armijo)
-// line search on E. Converged when |g| <= newton_tol |g_0|, g_0 the gradient
-// at the step's start (v = v~), or below a round-off floor.
+//     (Energy and amplification of both: integrators/integrator.hpp.)
+// Newton's method on E with CG and a line search: integrators/integrator.hpp.
 //
 // Constraints act inside the solve: the unknowns are the velocities of the
 // active nodes; a pinned node (v = 0), a node inside a collider (its velocity
@@ -64,6 +39,7 @@
 
 #include "core/stencil.hpp"
 #include "core/stepper.hpp"
+#include "integrators/conjugate_gradient.hpp"
 #include "integrators/integrator.hpp"
 #include "kernels/all.hpp"
 
@@ -413,36 +389,13 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
   }
 
   Real dot(const V& a, const V& b) const {
-    Real s = 0;
-    for (const long i : nodes_) s += a[i].dot(b[i]);
-    return s;
+    return node_dot<Dim>(nodes_, a, b);
   }
 
   // Preconditioned CG on H x = b to |r| <= tol; returns the iterations.
   long conjugate_gradients(const V& b, V& x, Real tol) {
-    const std::size_t N = mass_.size();
-    x.assign(N, Vec<Dim>::Zero());
-    V r = b, z(N, Vec<Dim>::Zero()), q(N, Vec<Dim>::Zero()), Aq;
-    for (const long i : nodes_) z[i] = inv_diag_[i].cwiseProduct(r[i]);
-    q = z;
-    Real rz = dot(r, z);
-    long k = 0;
-    for (; k < opt_.cg_max && std::sqrt(dot(r, r)) > tol; ++k) {
-      apply_hessian(q, Aq);
-      const Real qAq = dot(q, Aq);
-      if (!(qAq > 0)) break;  // not positive definite along q (cannot happen when projected)
-      const Real alpha = rz / qAq;
-      for (const long i : nodes_) {
-        x[i] += alpha * q[i];
-        r[i] -= alpha * Aq[i];
-        z[i] = inv_diag_[i].cwiseProduct(r[i]);
-      }
-      const Real rz_new = dot(r, z);
-      const Real beta = rz_new / rz;
-      rz = rz_new;
-      for (const long i : nodes_) q[i] = z[i] + beta * q[i];
-    }
-    return k;
+    return preconditioned_cg<Dim>(nodes_, inv_diag_, b, x, tol, opt_.cg_max,
+                                  [&](const V& q, V& Aq) { apply_hessian(q, Aq); });
   }
 
   // Newton's method from v~; fills stats_.

@@ -8,6 +8,31 @@
 // ("Optimization integrator for large time steps", IEEE TVCG 21(10)) with
 // Newton's method (methods/integrators/implicit_impl.hpp). Only the interface
 // is here: core/stepper.hpp includes it.
+// The implicit integrators (integrators/implicit_impl.hpp):
+//   Newmark (beta = 1/4, gamma = 1/2) energy: for a quadratic psi, Psi(F^n+1) - Psi(F^n) = (P^n +
+//   P^n+1)/2 :
+//     (F^n+1 - F^n) = -dt/2 (v^n + v^n+1) . (f^n + f^n+1)/2, while the kinetic
+//     energy changes by m (v^n+1 - v^n) . (v^n+1 + v^n)/2 = the same with the
+//     opposite sign: the grid energy is kept exactly (to the solver's
+//     tolerance). For one mode x'' = -omega^2 x the step's amplification is
+//     A = (1 - (omega dt/2)^2 + i omega dt) / (1 + (omega dt/2)^2) with
+//     |A|^2 = ((1 - z^2)^2 + 4 z^2) / (1 + z^2)^2 = 1, z = omega dt / 2:
+//     no growth or decay at any dt, a phase error of O((omega dt)^3) per step.
+//     (Backward Euler: A = 1 / (1 - i omega dt), |A| = 1 / sqrt(1 + (omega dt)^2).)
+// Newton's method on E: the Hessian-vector product
+//   H d = m d + h^2 sum_p V0_p (dP/dF : dF_p) F_p^nT grad w_ip,
+//   dF_p = sum_i d_i grad w_ip^T F_p^n,
+// with each particle's dP/dF (a Dim^2 x Dim^2 block, built from the model's
+// first_piola_differential) projected to positive semi-definite by clamping
+// its negative eigenvalues (Teran, Sifakis, Irving & Fedkiw 2005, "Robust
+// quasistatic finite elements and flesh simulation", sec. 5, per particle
+// instead of per element), so that every direction descends. The linear
+// systems are solved matrix-free by our own Jacobi-preconditioned conjugate
+// gradients (integrators/conjugate_gradient.hpp): the operator acts on the grid's Vec<Dim> arrays
+// over the active nodes with the constraints folded in, which Eigen's CG would need a wrapper type
+// and a flattening copy for, for no gain. An inexact Newton forcing term (|r| <= min(cg_tol,
+// |g|/|g_0|) |g|) and a backtracking (Armijo) line search on E. Converged when |g| <= newton_tol
+// |g_0|, g_0 the gradient at the step's start (v = v~), or below a round-off floor.
 #pragma once
 
 #include <array>

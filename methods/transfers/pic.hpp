@@ -10,8 +10,8 @@
 
 #include <string_view>
 
-#include "core/papers.hpp"
 #include "core/deformation.hpp"
+#include "core/papers.hpp"
 #include "core/parameters.hpp"
 #include "core/particles.hpp"
 #include "core/tensor_transfer.hpp"
