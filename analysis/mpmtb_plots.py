@@ -124,6 +124,11 @@ TRANSFER_COLOURS = {"pic": "tab:blue", "flip": "tab:orange",
 KERNEL_LINESTYLES = {"linear": ":", "quadratic": "-", "cubic": "-.",
                      "gimp": (0, (5, 1))}
 KERNEL_HATCHES = {"linear": "..", "quadratic": "", "cubic": "//", "gimp": "xx"}
+# Time integrators (issue 19): a method of the suites is transfer x kernel x
+# integrator; explicit is the default and keeps the plain "transfer-kernel" name.
+INTEGRATORS = ("explicit", "backward-euler", "newmark")
+INTEGRATOR_MARKERS = {"explicit": "o", "backward-euler": "s", "newmark": "^"}
+INTEGRATOR_SHORT = {"explicit": "", "backward-euler": "BE", "newmark": "NM"}
 # Black and "--" are kept for exact / reference curves.
 EXACT_STYLE = {"color": "black", "linestyle": "--", "linewidth": 1.2}
 _SPARE_COLOURS = ("tab:gray", "gold", "navy", "lime")
@@ -150,6 +155,22 @@ def bar_style(transfer, kernel):
     return {"color": _pick(transfer, TRANSFER_COLOURS, _SPARE_COLOURS),
             "hatch": _pick(kernel, KERNEL_HATCHES, _SPARE_HATCHES),
             "edgecolor": "black", "linewidth": 0.6}
+
+
+def integrator_of(row):
+    """A suite table row's integrator; tables from before the integrator
+    column are explicit."""
+    return row.get("integrator") or "explicit"
+
+
+def method_label(transfer, kernel, integrator="explicit"):
+    """transfer-kernel, with /integrator for an implicit one."""
+    base = f"{transfer}-{kernel}"
+    return base if integrator == "explicit" else f"{base}/{integrator}"
+
+
+def integrator_marker(integrator):
+    return _pick(integrator, INTEGRATOR_MARKERS, ("D", "v", "P"))
 
 
 def _rank(name, known):

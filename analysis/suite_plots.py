@@ -7,6 +7,8 @@ returns the written PNG paths (empty when the table is absent):
                               transfer, reference slopes 1 and 2
   convergence/<case>_dt.png   the same against dt at a fixed grid
   stability/stability_map.png largest stable CFL per method and case x ppc
+                              (a method: transfer-kernel, /integrator for the
+                              implicit ones; ">=" where no tried CFL failed)
   stability/failure_modes.png the failure-mode metrics per method
   speed_accuracy/<case>_work_precision.png  work-precision diagram: error
                               against time per run and particle-steps, one
@@ -48,12 +50,21 @@ def ordered(names, known):
 
 
 def method_name(row):
-    return f"{row['transfer']}-{row['kernel']}"
+    return mp.method_label(row["transfer"], row["kernel"],
+                           mp.integrator_of(row))
+
+
+def method_key(row):
+    """(transfer, kernel, integrator) of a table row."""
+    return (row["transfer"], row["kernel"], mp.integrator_of(row))
 
 
 def methods_of(rows):
-    pairs = {(r["transfer"], r["kernel"]) for r in rows}
-    return sorted(pairs, key=lambda p: (
+    """The (transfer, kernel, integrator) triples of the rows: the explicit
+    methods first, then each implicit integrator's, in canonical order."""
+    triples = {method_key(r) for r in rows}
+    return sorted(triples, key=lambda p: (
+        mp.INTEGRATORS.index(p[2]) if p[2] in mp.INTEGRATORS else 99,
         mp.TRANSFERS.index(p[0]) if p[0] in mp.TRANSFERS else 99,
         mp.KERNELS.index(p[1]) if p[1] in mp.KERNELS else 99, p))
 
@@ -82,16 +93,18 @@ def plot_convergence_table(path, xkey, xlabel):
     drawn = False
     for ax, kernel in zip(axes[0], kernels):
         xs_all, ys_all = [], []
-        transfers = ordered([r["transfer"] for r in rows
-                             if r["kernel"] == kernel], mp.TRANSFERS)
-        for transfer in transfers:
+        lines = [(t, i) for t, k, i in methods_of(rows) if k == kernel]
+        for transfer, integrator in lines:
             pts = [(num(r, xkey), num(r, "error")) for r in rows
-                   if r["kernel"] == kernel and r["transfer"] == transfer]
+                   if method_key(r) == (transfer, kernel, integrator)]
             pts = [(x, y) for x, y in pts if x > 0 and y > 0]
             if not pts:
                 continue
             x, y = zip(*pts)
-            ax.plot(x, y, marker="o", markersize=3.5, label=transfer,
+            label = transfer if integrator == "explicit" else \
+                f"{transfer}/{integrator}"
+            ax.plot(x, y, marker=mp.integrator_marker(integrator),
+                    markersize=3.5, label=label,
                     **mp.line_style(transfer, kernel))
             xs_all += x
             ys_all += y
@@ -130,6 +143,15 @@ def plot_convergence(suites):
 
 # ------------------------------------------------------------ stability --
 
+def stable_text(row):
+    """The largest stable CFL of a stable_cfl.csv row as shown: ">=" where no
+    tried value failed (the implicit integrators), "-" where none was stable."""
+    c = num(row, "stable_cfl")
+    if not np.isfinite(c):
+        return "-"
+    return f"{c:.2f}" if row.get("first_unstable_cfl") else f">={c:g}"
+
+
 def plot_stability_map(suites):
     path = os.path.join(suites, "stability", "stable_cfl.csv")
     rows = read_rows(path)
@@ -138,28 +160,46 @@ def plot_stability_map(suites):
     methods = methods_of(rows)
     columns = list(dict.fromkeys((r["case"], r["ppc"]) for r in rows))
     grid = np.full((len(methods), len(columns)), np.nan)
+    text = [["-"] * len(columns) for _ in methods]
     for r in rows:
-        i = methods.index((r["transfer"], r["kernel"]))
-        grid[i, columns.index((r["case"], r["ppc"]))] = num(r, "stable_cfl")
-    fig, ax = plt.subplots(figsize=(1.3 + 0.9 * len(columns),
+        i, j = methods.index(method_key(r)), columns.index((r["case"], r["ppc"]))
+        grid[i, j] = num(r, "stable_cfl")
+        text[i][j] = stable_text(r)
+    fig, ax = plt.subplots(figsize=(max(5.5, 1.3 + 0.9 * len(columns)),
                                     1.2 + 0.38 * len(methods)))
+    finite = grid[np.isfinite(grid) & (grid > 0)]
+    # The implicit integrators' CFL reaches 100 beside explicit limits near 1:
+    # a log colour scale keeps both readable.
+    log = finite.size and finite.max() > 10 * finite.min()
+    norm = mp.matplotlib.colors.LogNorm() if log else None
     image = ax.imshow(np.ma.masked_invalid(grid), cmap="viridis",
-                      aspect="auto")
+                      aspect="auto", norm=norm)
+    middle = (np.exp(np.mean(np.log(finite))) if log else np.mean(finite)) \
+        if finite.size else np.nan
     for i in range(len(methods)):
         for j in range(len(columns)):
-            text = "-" if np.isnan(grid[i, j]) else f"{grid[i, j]:.2f}"
-            ax.text(j, i, text, ha="center", va="center", fontsize=8,
-                    color="white" if np.nan_to_num(grid[i, j]) <
-                    np.nanmean(grid) else "black")
+            ax.text(j, i, text[i][j], ha="center", va="center", fontsize=8,
+                    color="white" if np.isfinite(grid[i, j]) and
+                    grid[i, j] < middle else "black")
+    # A line between the explicit methods and each implicit integrator's.
+    for i in range(1, len(methods)):
+        if methods[i][2] != methods[i - 1][2]:
+            ax.axhline(i - 0.5, color="red", linewidth=1.2)
     ax.set_xticks(range(len(columns)),
                   [f"{c}\nppc {p}" for c, p in columns], fontsize=8)
-    ax.set_yticks(range(len(methods)), [f"{t}-{k}" for t, k in methods])
+    ax.set_yticks(range(len(methods)),
+                  [mp.method_label(*m) for m in methods])
     estimates = {}
     for r in rows:
-        estimates[r["kernel"]] = (r["vn_low"], r["vn_high"])
+        if mp.integrator_of(r) == "explicit":
+            estimates[r["kernel"]] = (r["vn_low"], r["vn_high"])
     note = ", ".join(f"{k} {lo}" + ("" if lo == hi else f"-{hi}")
                      for k, (lo, hi) in estimates.items())
-    ax.set_title(f"largest stable CFL (von Neumann: {note})", fontsize=9)
+    title = f"largest stable CFL (von Neumann: {note})"
+    if any(m[2] != "explicit" for m in methods):
+        title += ("\nimplicit (below the red line): >= the largest CFL "
+                  "tried when none failed")
+    ax.set_title(title, fontsize=9)
     fig.colorbar(image, ax=ax, label="CFL")
     fig.tight_layout()
     out = os.path.join(suites, "stability", "stability_map.png")
@@ -184,8 +224,7 @@ def plot_failure_modes(suites):
                              figsize=(3.2 * len(cases) + 0.6,
                                       1.2 + 0.3 * len(methods)))
     for ax, case in zip(axes[0], cases):
-        by_method = {(r["transfer"], r["kernel"]): r for r in rows
-                     if r["case"] == case}
+        by_method = {method_key(r): r for r in rows if r["case"] == case}
         values = [num(by_method[m], "value") if m in by_method else np.nan
                   for m in methods]
         floor = 1e-17
@@ -193,15 +232,15 @@ def plot_failure_modes(suites):
         for i, (m, v) in enumerate(zip(methods, values)):
             if np.isfinite(v):
                 ax.barh(i, max(abs(v), floor) if log else v,
-                        **mp.bar_style(*m))
+                        **mp.bar_style(m[0], m[1]))
             else:
                 status = by_method.get(m, {}).get("status", "missing")
                 ax.text(0.02, i, status, va="center", fontsize=7,
                         transform=ax.get_yaxis_transform(), color="red")
         if log:
             ax.set_xscale("log")
-        ax.set_yticks(range(len(methods)), [f"{t}-{k}" for t, k in methods],
-                      fontsize=8)
+        ax.set_yticks(range(len(methods)),
+                      [mp.method_label(*m) for m in methods], fontsize=8)
         ax.invert_yaxis()
         metric = next(r["metric"] for r in rows if r["case"] == case)
         ax.set_xlabel(METRIC_LABELS.get(metric, metric), fontsize=8)
@@ -216,13 +255,22 @@ def plot_failure_modes(suites):
 
 # ------------------------------------------------------- speed-accuracy --
 
+def series_label(row):
+    """A work-precision series: the method, with its CFL for an implicit one."""
+    name = method_name(row)
+    if mp.integrator_of(row) == "explicit":
+        return name
+    return f"{name} CFL {num(row, 'cfl'):g}"
+
+
 def finest_throughput(rows):
-    """{(transfer, kernel): particle-steps/s of the finest ok level}."""
+    """{series label: particle-steps/s of the finest ok level}, in the rows'
+    order (a series: a method, and for an implicit one its CFL)."""
     best = {}
     for r in rows:
         if r["status"] != "ok":
             continue
-        key = (r["transfer"], r["kernel"])
+        key = series_label(r)
         level = num(r, "level")
         if key not in best or level > best[key][0]:
             best[key] = (level, num(r, "particle_steps_per_second"))
@@ -238,13 +286,15 @@ def plot_throughput(suites, tables):
     fig, axes = plt.subplots(1, len(cases), squeeze=False,
                              figsize=(4.0 * len(cases) + 1.0, 4.2))
     for ax, (case, rates) in zip(axes[0], cases):
-        methods = methods_of([{"transfer": t, "kernel": k} for t, k in rates])
-        for i, m in enumerate(methods):
-            ax.barh(i, rates[m], **mp.bar_style(*m))
+        rows = {series_label(r): r for r in read_rows(
+            os.path.join(suites, "speed_accuracy", case + ".csv"))}
+        labels = list(rates)
+        for i, m in enumerate(labels):
+            ax.barh(i, rates[m], **mp.bar_style(rows[m]["transfer"],
+                                                rows[m]["kernel"]))
             ax.annotate(f" {rates[m]:.3g}", (rates[m], i), va="center",
                         fontsize=7)
-        ax.set_yticks(range(len(methods)), [f"{t}-{k}" for t, k in methods],
-                      fontsize=8)
+        ax.set_yticks(range(len(labels)), labels, fontsize=8)
         ax.invert_yaxis()
         ax.margins(x=0.2)
         ax.set_xlabel("particle-steps per second (finest level, 1 thread, "

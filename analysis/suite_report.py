@@ -30,9 +30,9 @@ def pivot(rows, column_key, value):
     methods = sp.methods_of(rows)
     grid = {(m, c): "" for m in methods for c in columns}
     for r in rows:
-        grid[((r["transfer"], r["kernel"]), column_key(r))] = value(r)
-    body = [[f"`{t}-{k}`"] + [grid[((t, k), c)] for c in columns]
-            for t, k in methods]
+        grid[(sp.method_key(r), column_key(r))] = value(r)
+    body = [[f"`{mp.method_label(*m)}`"] + [grid[(m, c)] for c in columns]
+            for m in methods]
     return columns, body
 
 
@@ -67,8 +67,8 @@ def stability_section(suites):
         return []
 
     def value(r):
-        c = sp.num(r, "stable_cfl")
-        return "none" if not np.isfinite(c) else f"{c:.2f}"
+        text = sp.stable_text(r)
+        return "none" if text == "-" else text
     columns, body = pivot(rows, lambda r: f"{r['case']} ppc {r['ppc']}",
                           value)
     failures = sorted({r["failure"] for r in rows if r["failure"]})
@@ -84,7 +84,11 @@ def stability_section(suites):
              "its grid-particle-grid projection P damps the highest mode "
              "and symplectic Euler is stable for omega^2 dt^2 <= 2 (1 + P) "
              "(derived in tests/e2e_suites.sh: 0.79 linear, 1.42 quadratic, "
-             "1.56 cubic at ppc 2). Every run: "
+             "1.56 cubic at ppc 2). The implicit integrators "
+             "(`/backward-euler`, `/newmark`: Newton on the incremental "
+             "potential, unconditionally stable for linear elasticity) run "
+             "their own CFL values far beyond the explicit limit; `>=` marks "
+             "the largest one tried where none failed. Every run: "
              "`suites/stability/<case>.csv`.", ""]
             + table(["method"] + columns, body))
 
@@ -124,9 +128,8 @@ def speed_section(suites):
         case = os.path.basename(path)[:-4]
         rates = sp.finest_throughput(rows)
         if rates:
-            body = [[f"`{t}-{k}`", f"{rates[(t, k)]:.3g}"]
-                    for t, k in sp.methods_of(
-                        [{"transfer": t, "kernel": k} for t, k in rates])]
+            body = [[f"`{label}`", f"{rate:.3g}"]
+                    for label, rate in rates.items()]
             lines += [f"### Throughput: {case}", "",
                       "Particle-steps per second at the finest level, one "
                       "thread, each run alone, median of 3 repetitions of at "
@@ -138,7 +141,7 @@ def speed_section(suites):
         key = good[0].get("error_key", "error")
         front = [r for r in good if r["pareto_time"] == "1"]
         front.sort(key=lambda r: sp.num(r, "time_s"))
-        body = [[f"`{r['transfer']}-{r['kernel']}`", r["cells"],
+        body = [[wp.run_name(r), r["cells"],
                  f"{sp.num(r, 'error'):.3g}", f"{sp.num(r, 'energy_error'):.2g}",
                  wp.cost_text(r), f"{sp.num(r, 'cpu_s'):.3g}",
                  f"{sp.num(r, 'particle_steps'):.3g}",
@@ -146,7 +149,8 @@ def speed_section(suites):
         lines += [f"### Pareto front: {case}", "",
                   f"Error `error.{key}` against the time of one run (median "
                   "of 3 repetitions timed alone, min-max in brackets): the "
-                  "runs no other run beats in both. Energy error, CPU time "
+                  "runs no other run beats in both (an implicit integrator's "
+                  "runs with their CFL). Energy error, CPU time "
                   "and particle-steps beside them; the last column: also on "
                   "the front of error against particle-steps. Figure: "
                   f"`suites/speed_accuracy/{case}_work_precision.png`.", ""]

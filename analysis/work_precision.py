@@ -11,6 +11,11 @@ multiples, one panel per kernel, one line per transfer, the spread of the
 repetitions as horizontal error bars, and the Pareto front of the whole case
 (no run is both cheaper and more accurate) in black.
 
+A method is transfer x kernel x time integrator: the implicit integrators
+(backward Euler, Newmark) run the same grids at larger steps (the `cfl`
+column), one line per integrator and CFL, marked by integrator (circle:
+explicit, square: backward Euler, triangle: Newmark) and dashed by CFL.
+
   <case>_work_precision.png  error against time per run (top row) and against
                              particle-steps (bottom row), one column per kernel
 """
@@ -49,6 +54,46 @@ def transfers_of(rows):
                                         if t in mp.TRANSFERS else 99, t))
 
 
+def lines_of(rows):
+    """The lines of a panel: (transfer, integrator, cfl), the explicit ones
+    first, each integrator's CFLs ascending."""
+    keys = {line_key(r) for r in rows}
+    return sorted(keys, key=lambda k: (
+        mp.INTEGRATORS.index(k[1]) if k[1] in mp.INTEGRATORS else 99,
+        mp.TRANSFERS.index(k[0]) if k[0] in mp.TRANSFERS else 99, k[0],
+        cfl_value(k[2])))
+
+
+def cfl_value(text):
+    """A CFL cell as a number (0 where the table has none)."""
+    v = num({"cfl": text}, "cfl")
+    return v if np.isfinite(v) else 0.0
+
+
+def line_key(row):
+    """(transfer, integrator, CFL as printed): a line through the grids."""
+    return (row["transfer"], mp.integrator_of(row), row.get("cfl", ""))
+
+
+def line_label(transfer, integrator, cfl):
+    if integrator == "explicit":
+        return transfer
+    return f"{transfer}/{integrator} CFL {cfl_value(cfl):g}"
+
+
+CFL_DASHES = ("--", "-.", ":", (0, (5, 1)))
+
+
+def line_dash(rows, transfer, integrator, cfl):
+    """Solid for the explicit lines; for an implicit integrator's lines a
+    dash pattern by the rank of the CFL among its CFLs."""
+    if integrator == "explicit":
+        return "-"
+    cfls = sorted({cfl_value(r.get("cfl", "")) for r in rows
+                   if mp.integrator_of(r) == integrator})
+    return CFL_DASHES[cfls.index(cfl_value(cfl)) % len(CFL_DASHES)]
+
+
 def error_label(rows):
     key = rows[0].get("error_key", "") if rows else ""
     return {"field_rel": "displacement field error / amplitude (max over t)",
@@ -73,22 +118,26 @@ def plot_work_precision(path):
                        if r.get(flag) == "1")
         for ax, kernel in zip(row_axes, kernels):
             mine = [r for r in rows if r["kernel"] == kernel]
-            for transfer in transfers_of(mine):
-                pts = sorted((num(r, cost), num(r, "error"), r) for r in mine
-                             if r["transfer"] == transfer)
+            for key in lines_of(mine):
+                transfer, integrator, cfl = key
+                pts = sorted(((num(r, cost), num(r, "error"), i, r)
+                              for i, r in enumerate(mine)
+                              if line_key(r) == key), key=lambda p: p[:3])
                 x = np.array([p[0] for p in pts])
                 y = np.array([p[1] for p in pts])
                 style = mp.line_style(transfer, kernel)
-                style["linestyle"] = "-"
+                style["linestyle"] = line_dash(rows, *key)
+                marker = mp.integrator_marker(integrator)
+                name = line_label(*key)
                 if cost == "time_s":
-                    lo = x - np.array([num(p[2], "time_min_s") for p in pts])
-                    hi = np.array([num(p[2], "time_max_s") for p in pts]) - x
+                    lo = x - np.array([num(p[3], "time_min_s") for p in pts])
+                    hi = np.array([num(p[3], "time_max_s") for p in pts]) - x
                     ax.errorbar(x, y, xerr=[np.nan_to_num(lo),
                                             np.nan_to_num(hi)],
-                                marker="o", markersize=3.5, capsize=2,
-                                label=transfer, **style)
+                                marker=marker, markersize=3.5, capsize=2,
+                                label=name, **style)
                 else:
-                    ax.plot(x, y, marker="o", markersize=3.5, label=transfer,
+                    ax.plot(x, y, marker=marker, markersize=3.5, label=name,
                             **style)
             if front:
                 fx, fy = zip(*front)
@@ -141,12 +190,13 @@ def tolerances(rows):
 
 
 def cheapest(rows, tol, count=3):
-    """The `count` cheapest methods (each with its cheapest grid) whose error
-    is at most tol, by median time per run."""
+    """The `count` cheapest methods (each with its cheapest grid and, for an
+    implicit integrator, step) whose error is at most tol, by median time per
+    run."""
     best = {}
     for r in rows:
         if num(r, "error") <= tol:
-            key = (r["transfer"], r["kernel"])
+            key = (r["transfer"], r["kernel"], mp.integrator_of(r))
             if key not in best or num(r, "time_s") < num(best[key], "time_s"):
                 best[key] = r
     return sorted(best.values(), key=lambda r: num(r, "time_s"))[:count]
@@ -157,8 +207,16 @@ def cost_text(r):
             f"{num(r, 'time_max_s'):.3g})")
 
 
+def run_name(r):
+    """`method` as the tables print it: with its CFL for an implicit one."""
+    name = mp.method_label(r["transfer"], r["kernel"], mp.integrator_of(r))
+    if mp.integrator_of(r) == "explicit":
+        return f"`{name}`"
+    return f"`{name}` CFL {num(r, 'cfl'):g}"
+
+
 def pick_text(r):
-    return (f"`{r['transfer']}-{r['kernel']}` {r['cells']} cells: "
+    return (f"{run_name(r)} {r['cells']} cells: "
             f"{cost_text(r)}, error {num(r, 'error'):.2g}")
 
 
@@ -177,6 +235,6 @@ def front_text(rows, flag):
     period error."""
     front = sorted((r for r in rows if r.get(flag) == "1"),
                    key=lambda r: num(r, "time_s"))
-    return ", ".join(f"`{r['transfer']}-{r['kernel']}` {r['cells']} "
+    return ", ".join(f"{run_name(r)} {r['cells']} "
                      f"(error {num(r, 'error'):.2g}, period "
                      f"{num(r, 'period_error'):.2g})" for r in front)

@@ -10,10 +10,13 @@ rm -rf "$work" && mkdir -p "$work/bar"
 # refinement, stability map, failure modes, Pareto and throughput).
 "$mpmtb" suite convergence --case bar --kernel quadratic --kernel cubic --transfer mls \
   --transfer pic --quiet --out "$work/suites"
-"$mpmtb" suite stability --case bar_fixed --case translate --transfer mls --kernel linear \
-  --kernel cubic --quiet --out "$work/suites"
+# The implicit integrators as the third axis of a method (issue 19): on the
+# stability map beside the explicit ones (APIC takes them, MLS-MPM does not), and
+# Newmark's work-precision series beside the explicit ones.
+"$mpmtb" suite stability --case bar_fixed --case translate --transfer mls --transfer apic \
+  --kernel linear --kernel cubic --quiet --out "$work/suites"
 "$mpmtb" suite speed-accuracy --case bar_2d --transfer apic --transfer pic --kernel quadratic \
-  --quiet --out "$work/suites"
+  --integrator explicit --integrator newmark --quiet --out "$work/suites"
 /usr/bin/python3 "$source_dir/analysis/plot_all.py" --results "$work"
 test -s "$work/README.md"
 figures=$(grep -o '([^)]*\.png)' "$work/README.md" | tr -d '()')
@@ -40,6 +43,37 @@ for r in rows:
     lo, med, hi = float(r["time_min_s"]), float(r["time_s"]), float(r["time_max_s"])
     assert 0 < lo <= med <= hi, r
     assert int(r["repeats"]) >= 3 and int(r["passes"]) >= 1, r
+PY
+# The integrator axis in the tables, the report and the figures' legends.
+grep -q "^case,transfer,kernel,integrator,cfl,level," "$work/suites/speed_accuracy/bar_2d.csv" ||
+  { echo "no integrator column in the work-precision table"; exit 1; }
+grep -q "^bar_2d,apic,quadratic,newmark,16,2," "$work/suites/speed_accuracy/bar_2d.csv" ||
+  { echo "no Newmark run at CFL 16"; exit 1; }
+grep -q "apic-quadratic/newmark. CFL 16" "$work/README.md" ||
+  { echo "no Newmark run in the report"; exit 1; }
+for i in newmark backward-euler; do
+  grep -q "| .apic-cubic/$i. | .*>=" "$work/README.md" ||
+    { echo "apic-cubic/$i missing from the stability table"; exit 1; }
+done
+/usr/bin/python3 - "$source_dir/analysis" "$work/suites" <<'PY'
+import sys
+sys.path.insert(0, sys.argv[1])
+import matplotlib
+matplotlib.use("Agg")
+import suite_plots as sp
+import work_precision as wp
+import mpmtb_plots as mp
+# The work-precision legend names each implicit series with its CFL; the
+# stability map has a row per integrator.
+rows = mp.read_table(f"{sys.argv[2]}/speed_accuracy/bar_2d.csv")[1]
+labels = {wp.line_label(*k) for k in wp.lines_of(wp.usable(rows))}
+for cfl in (1, 4, 16):
+    assert f"apic/newmark CFL {cfl}" in labels, labels
+assert {"apic", "pic"} <= labels, labels
+stable = sp.read_rows(f"{sys.argv[2]}/stability/stable_cfl.csv")
+methods = sp.methods_of(stable)
+for i in ("explicit", "backward-euler", "newmark"):
+    assert ("apic", "cubic", i) in methods, methods
 PY
 for run in $("$mpmtb" list transfers); do
   grep -q "$run-linear" "$work/README.md" || { echo "$run-linear missing from the index"; exit 1; }

@@ -97,6 +97,10 @@ CLI::App* add_suite_command(CLI::App& app, mpmtb::SuiteRequest& r) {
   cmd->add_option("--case", r.cases, "only these cases (repeatable)");
   cmd->add_option("--transfer", r.transfers, "only these transfers (repeatable)");
   cmd->add_option("--kernel", r.kernels, "only these kernels (repeatable)");
+  cmd->add_option("--integrator", r.integrators,
+                  fmt::format("only these time integrators (repeatable): {}; the implicit ones run "
+                              "where a case lists them, in the convergence suite only when named",
+                              fmt::join(mpmtb::kIntegratorNames, ", ")));
   auto* shard = cmd->add_option(
       "--shard", r.shard,
       "K/N: run only the K-th of N disjoint parts of the run list (balanced by estimated cost), "

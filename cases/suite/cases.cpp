@@ -84,12 +84,24 @@ const std::vector<ConvergenceCase>& convergence_cases() {
 // FLIP only, the transfers here that do not take D_p as diagonal) on three
 // grids; 3D without PolyPIC (6x APIC's cost per particle-step there) and with the
 // hat and the B-splines only (CPDI's 64-node stencil is the 3D cost outlier).
+// The implicit integrators (issue 19) join the 2D cases at steps 5, 20 and 80
+// times the explicit runs' (CFL 1, 4, 16 against 0.2) on the same grids: APIC
+// with the quadratic B-spline at the quick level (each implicit run costs 2 to
+// 20 explicit ones per step: Newton iterations of CG iterations of a particle
+// loop), FLIP and PIC with the hat and the cubic B-spline beside it with --full.
 const std::vector<ConvergenceCase>& speed_accuracy_cases() {
   static const std::vector<std::string> transfers = {"pic", "flip", "apic", "mls", "polypic"};
   static const std::vector<std::string> transfers_3d = {"pic", "flip", "apic", "mls"};
   static const std::vector<std::string> kernels = {"linear", "quadratic", "cubic",
                                                    "gimp",   "cpgimp",    "cpdi"};
   static const std::vector<std::string> kernels_3d = {"linear", "quadratic", "cubic"};
+  static const std::vector<IntegratorStep> implicit = {
+      {"backward-euler", 1}, {"backward-euler", 4}, {"backward-euler", 16},
+      {"newmark", 1},        {"newmark", 4},        {"newmark", 16}};
+  static const std::vector<std::string> implicit_transfers = {"apic"},
+                                        implicit_kernels = {"quadratic"};
+  static const std::vector<std::string> implicit_transfers_full = {"pic", "flip", "apic"},
+                                        implicit_kernels_full = {"linear", "quadratic", "cubic"};
   static const std::vector<ConvergenceCase> cases = {
       {"bar_2d",
        "bar",
@@ -105,7 +117,12 @@ const std::vector<ConvergenceCase>& speed_accuracy_cases() {
        0,
        0.5,
        transfers,
-       kernels},
+       kernels,
+       implicit,
+       implicit_transfers,
+       implicit_kernels,
+       implicit_transfers_full,
+       implicit_kernels_full},
       {"mms_axis_2d",
        "mms_axis",
        2,
@@ -120,7 +137,12 @@ const std::vector<ConvergenceCase>& speed_accuracy_cases() {
        0,
        0.5,
        transfers,
-       kernels},
+       kernels,
+       implicit,
+       implicit_transfers,
+       implicit_kernels,
+       implicit_transfers_full,
+       implicit_kernels_full},
       {"mms_axis_3d",
        "mms_axis",
        3,
@@ -145,6 +167,13 @@ const std::vector<StabilityCase>& stability_cases() {
   // node carries a full mass: the setting of the von Neumann estimate.
   // bar: the canonical fixed-free bar; the nodes past its free end carry tiny
   // masses and lower the limit.
+  // The implicit integrators (issue 19) on both, at ppc 2: CFL 0.5 to 100 on a
+  // log-ish grid, 25 to 60 times the explicit limit at its end.
+  static const std::vector<std::string> implicit_transfers = {"pic", "flip", "apic"};
+  static const std::vector<std::string> implicit_kernels = {"linear", "quadratic", "cubic"};
+  static const std::vector<double> implicit_quick = {0.5, 1, 2, 5, 10, 20, 50, 100};
+  static const std::vector<double> implicit_full = {0.25, 0.5, 1,  1.5, 2,  3,  5,   7.5,
+                                                    10,   15,  20, 30,  50, 75, 100, 200};
   static const std::vector<StabilityCase> cases = {
       {"bar_fixed",
        "bar",
@@ -153,8 +182,31 @@ const std::vector<StabilityCase>& stability_cases() {
        16,
        0,
        {1, 2, 4},
-       {1, 2, 3, 4}},
-      {"bar", "bar", 1, {}, 16, 0, {2}, {1, 2, 3, 4}},
+       {1, 2, 3, 4},
+       0.1,
+       2.5,
+       0.1,
+       0.025,
+       implicit_transfers,
+       implicit_kernels,
+       implicit_quick,
+       implicit_full},
+      {"bar",
+       "bar",
+       1,
+       {},
+       16,
+       0,
+       {2},
+       {1, 2, 3, 4},
+       0.1,
+       2.5,
+       0.1,
+       0.025,
+       implicit_transfers,
+       implicit_kernels,
+       implicit_quick,
+       implicit_full},
   };
   return cases;
 }

@@ -14,6 +14,12 @@ struct Levels {
   std::vector<int> cells() const;
 };
 
+// An implicit integrator (integrators/integrator.hpp) at a fixed CFL.
+struct IntegratorStep {
+  std::string integrator;  // backward-euler | newmark
+  double cfl = 1;
+};
+
 // Convergence and speed-accuracy: refine grid and time step together at a
 // fixed CFL; error = summary `error.<error_key>`.
 struct ConvergenceCase {
@@ -31,6 +37,13 @@ struct ConvergenceCase {
   // Speed-accuracy: the methods of the quick level (empty: every one); --full
   // runs every registered transfer x kernel.
   std::vector<std::string> quick_transfers = {}, quick_kernels = {};
+  // Speed-accuracy, the implicit integrators (issue 19): each (integrator, CFL)
+  // pair runs the quick level's grids for these transfers x kernels; --full adds
+  // the full lists (the grids stay the quick ones: an implicit step on the full
+  // level's finest grid costs minutes).
+  std::vector<IntegratorStep> implicit_steps = {};
+  std::vector<std::string> implicit_transfers = {}, implicit_kernels = {};
+  std::vector<std::string> implicit_transfers_full = {}, implicit_kernels_full = {};
 };
 
 // Stability: a grid of CFL values for each particles-per-cell count.
@@ -42,6 +55,12 @@ struct StabilityCase {
   double t_end = 0;  // 0: the scene's
   std::vector<int> quick_ppc, full_ppc;
   double cfl_first = 0.1, cfl_last = 2.5, quick_step = 0.1, full_step = 0.025;
+  // The implicit integrators (issue 19): their own CFL values, far beyond the
+  // explicit limit, at implicit_ppc for these transfers x kernels (--full: at
+  // every ppc of the full level, every method that takes the integrator).
+  std::vector<std::string> implicit_transfers = {}, implicit_kernels = {};
+  std::vector<double> implicit_cfl_quick = {}, implicit_cfl_full = {};
+  int implicit_ppc = 2;
 };
 
 // Failure modes shown on purpose: one metric per case, every method.

@@ -23,6 +23,11 @@ struct Plan {
   std::function<void(const std::vector<RunResult>&)> write_tables;
 };
 
+// Each suite's plan (suite.cpp, stability.cpp, speed_accuracy.cpp).
+Plan plan_convergence(const SuiteRequest& request);
+Plan plan_stability(const SuiteRequest& request);
+Plan plan_speed_accuracy(const SuiteRequest& request);
+
 // The plans of a request (one, or three for `all`), in the order they run.
 std::vector<Plan> plan_suites(const SuiteRequest& request);
 

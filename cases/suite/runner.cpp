@@ -207,6 +207,7 @@ RunResult settle(const RunSpec& spec, const fs::path& dir, int wait_status, bool
     j["dim"] = spec.dim;
     j["transfer"] = spec.transfer;
     j["kernel"] = spec.kernel;
+    j["integrator"] = spec.integrator.empty() ? "explicit" : spec.integrator;
     j["cells"] = spec.cells;
     j["ppc"] = spec.ppc;
     r.summary = j;
@@ -276,6 +277,7 @@ std::vector<std::string> RunSpec::arguments(const fs::path& out) const {
   std::vector<std::string> a = {
       "run",      scene,  "--dim",   std::to_string(dim),   "--transfer", transfer,
       "--kernel", kernel, "--cells", std::to_string(cells), "--ppc",      std::to_string(ppc)};
+  if (!integrator.empty()) a.insert(a.end(), {"--integrator", integrator});
   if (cfl) a.insert(a.end(), {"--cfl", number(*cfl)});
   if (dt) a.insert(a.end(), {"--dt", number(*dt)});
   if (t_end) a.insert(a.end(), {"--t-end", number(*t_end)});

@@ -24,6 +24,7 @@ struct RunSpec {
   std::string case_name, scene;
   int dim = 1;
   std::string transfer, kernel;
+  std::string integrator;  // empty: explicit (no --integrator argument)
   int cells = 16, ppc = 2;
   std::optional<double> cfl, dt, t_end;
   std::vector<std::string> sets;  // --set key=value

@@ -6,7 +6,8 @@
 //   convergence/<case>.csv, <case>_dt.csv, orders.csv
 //   stability/<case>.csv, stable_cfl.csv, failure_modes.csv
 //   speed_accuracy/<case>.csv
-//   <suite>/runs/<case>/<transfer>-<kernel>/<label>/  one run each (done.json last)
+//   <suite>/runs/<case>/<transfer>-<kernel>/<label>/  one run each (done.json last);
+//   an implicit integrator's runs under <transfer>-<kernel>-<integrator>/
 #pragma once
 
 #include <string>
@@ -20,8 +21,10 @@ struct SuiteRequest {
   int jobs = 0;  // 0: the number of hardware threads
   std::string out = "results/suites";
   bool quiet = false;
-  // Filters (empty: everything): case names, transfers, kernels.
-  std::vector<std::string> cases, transfers, kernels;
+  // Filters (empty: everything): case names, transfers, kernels, time
+  // integrators (explicit, backward-euler, newmark; the implicit ones run where
+  // a case lists them, and in the convergence suite only when named here).
+  std::vector<std::string> cases, transfers, kernels, integrators;
   // "K/N": run only the K-th of N disjoint parts of the run list, write no
   // tables (cases/suite/shard.hpp). Empty: every run, then the tables.
   std::string shard;
