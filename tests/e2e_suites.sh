@@ -24,7 +24,7 @@ rm -rf "$work" && mkdir -p "$work"
 case "$mode" in
 stability)
   "$mpmtb" suite stability --quick --case bar_fixed --transfer apic --transfer mls \
-    --transfer pic --jobs 2 --quiet --out "$work"
+    --transfer pic --integrator explicit --jobs 2 --quiet --out "$work"
   /usr/bin/python3 - "$work/stability" <<'PY'
 import cmath, csv, math, sys
 root = sys.argv[1]
