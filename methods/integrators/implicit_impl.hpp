@@ -14,6 +14,8 @@
 //     dt (v^n + v^n+1)/2 and m (v^n+1 - v^n) = dt/2 (f^n + f^n+1).
 //     (Energy and amplification of both: integrators/integrator.hpp.)
 // Newton's method on E with CG and a line search: integrators/integrator.hpp.
+// The particles' side (F_p(v), stresses, dP/dF blocks, the sums into nodes, in
+// parallel and bit-identical for any thread count): integrators/implicit_particles.hpp.
 //
 // Constraints act inside the solve: the unknowns are the velocities of the
 // active nodes; a pinned node (v = 0), a node inside a collider (its velocity
@@ -29,7 +31,6 @@
 // "A material point method for snow simulation", sec. 9).
 #pragma once
 
-#include <Eigen/Eigenvalues>
 #include <algorithm>
 #include <cmath>
 #include <cstdint>
@@ -40,6 +41,7 @@
 #include "core/stencil.hpp"
 #include "core/stepper.hpp"
 #include "integrators/conjugate_gradient.hpp"
+#include "integrators/implicit_particles.hpp"
 #include "integrators/integrator.hpp"
 #include "kernels/all.hpp"
 
@@ -48,10 +50,6 @@ namespace mpmtb {
 template <int Dim, class Kernel>
 class ImplicitSolveT final : public ImplicitSolve<Dim> {
   using V = std::vector<Vec<Dim>>;
-  using StencilT = Stencil<Dim, Kernel>;
-  static constexpr int kD2 = Dim * Dim;
-  using Block = Eigen::Matrix<Real, kD2, kD2>;
-  using Flat = Eigen::Matrix<Real, kD2, 1>;
   using ImplicitSolve<Dim>::stats_;
 
  public:
@@ -69,8 +67,6 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     s_ = &s;
     h_ = newmark_ ? dt / 2 : dt;
     Grid<Dim>& g = s.grid;
-    const Particles<Dim>& P = s.particles;
-    const long n = static_cast<long>(P.size());
     stepper.scatter_momentum(s);  // m, p (the transfer's own), pinned nodes; f = 0
     // The active nodes (the box P2G swept).
     nodes_.clear();
@@ -82,22 +78,9 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     for (V* f : {&target_, &mask_, &fixed_, &vn_, &base_}) f->assign(N, Vec<Dim>::Zero());
     mass_.assign(N, 0);
     collider_.assign(N, 0);
-    stencils_.clear();
-    stencils_.reserve(P.size());
-    // Deformed-domain kernels (cpGIMP, CPDI) take F_p at the step's start, as P2G did.
-    for (long p = 0; p < n; ++p) stencils_.emplace_back(P.x[p], P.F[p], g.geo);
-    Fn_ = P.F;
-    F_ = P.F;
-    K_.resize(P.size());
+    particles_.setup(s);
     // Body forces into f before the walls fold it with m and p.
-    if (s.body_force) {
-      for (long p = 0; p < n; ++p) {
-        const Vec<Dim> mb = P.m[p] * s.body_force(P, static_cast<int>(p), s.time);
-        stencils_[p].for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
-          g.f[node] += w * mb;
-        });
-      }
-    }
+    if (s.body_force) particles_.scatter_body_force(g.f);
     s.walls.fold(g);
     for (const long i : nodes_) {
       if (g.m[i] > 0) {
@@ -119,7 +102,7 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
       // v~ += dt/2 f(F^n) / m, f(F^n) = -sum_p V0 P(F^n) F^nT grad w (folded;
       // with b = 0 still, v = 0 gives F^n).
       V div(N, Vec<Dim>::Zero());
-      stress_divergence(zeros(), div);
+      stress_divergence(zeros(), div);  // with b = 0 still: at F^n
       fold_ghosts(div);
       for (const long i : nodes_) {
         if (mass_[i] > 0) target_[i] -= (dt / 2 / mass_[i]) * div[i];
@@ -154,7 +137,7 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
   // positive semi-definite when `project`.
   void hessian_times(const V& u, const V& d, V& out, bool project) override {
     update_F(expand(u, true));
-    build_blocks(project);
+    particles_.build_blocks(project);
     apply_hessian(d, out);
   }
 
@@ -256,126 +239,31 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     }
   }
 
-  // F_p = (I + h sum_i (b_i + v_i) grad w_ip^T) F_p^n for every particle.
-  void update_F(const V& v) {
-    const Grid<Dim>& g = s_->grid;
-    const long n = static_cast<long>(Fn_.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-    for (long p = 0; p < n; ++p) {
-      Mat<Dim> G = Mat<Dim>::Zero();
-      stencils_[p].for_each_node(g.geo,
-                                 [&](long node, Real, const Vec<Dim>& grad, const Vec<Dim>&) {
-                                   G += (base_[node] + v[node]) * grad.transpose();
-                                 });
-      F_[p] = (Mat<Dim>::Identity() + h_ * G) * Fn_[p];
-    }
-  }
+  void update_F(const V& v) { particles_.update_F(base_, v, h_); }
 
   Real strain_energy(const V& v) {
     update_F(v);
-    const Particles<Dim>& P = s_->particles;
-    Real sum = 0;
-    for (std::size_t p = 0; p < F_.size(); ++p) {
-      sum += P.V0[p] * s_->materials[P.material[p]]->energy_density(F_[p], P.state_of(p));
-    }
-    return std::isfinite(sum) ? sum : std::numeric_limits<Real>::infinity();
+    return particles_.strain_energy();
   }
 
   // out_i += sum_p V0_p P(F_p(v)) F_p^nT grad w_ip (the negative internal force).
   void stress_divergence(const V& v, V& out) {
     update_F(v);
-    const Particles<Dim>& P = s_->particles;
-    const long n = static_cast<long>(F_.size());
-    Q_.resize(F_.size());
-    Real noise = 0;
-#pragma omp parallel for schedule(static) reduction(+ : noise) if (n >= kParallelMinimum)
-    for (long p = 0; p < n; ++p) {
-      const Mat<Dim> Pp = s_->materials[P.material[p]]->first_piola(F_[p], P.state_of(p));
-      Q_[p] = P.V0[p] * Pp * Fn_[p].transpose();
-      const ConstitutiveModel<Dim>& model = *s_->materials[P.material[p]];
-      const Real c = model.wave_speed();
-      noise += P.V0[p] * (Pp.norm() + model.density() * c * c * F_[p].norm()) * F_[p].norm();
-    }
-    psi_noise_ = std::numeric_limits<Real>::epsilon() * noise;
-    scatter_Q(out);
-  }
-  void scatter_Q(V& out) const {
-    const Grid<Dim>& g = s_->grid;
-    for (std::size_t p = 0; p < F_.size(); ++p) {
-      stencils_[p].for_each_node(g.geo, [&](long node, Real, const Vec<Dim>& grad,
-                                            const Vec<Dim>&) { out[node] += Q_[p] * grad; });
-    }
-  }
-
-  // Each particle's dP/dF at F_p as a Dim^2 x Dim^2 matrix on column-major
-  // vec(dF), optionally projected to positive semi-definite.
-  void build_blocks(bool project) {
-    const Particles<Dim>& P = s_->particles;
-    const long n = static_cast<long>(F_.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-    for (long p = 0; p < n; ++p) {
-      const ConstitutiveModel<Dim>& model = *s_->materials[P.material[p]];
-      Block K;
-      for (int j = 0; j < kD2; ++j) {
-        Mat<Dim> E = Mat<Dim>::Zero();
-        E(j % Dim, j / Dim) = 1;
-        const Mat<Dim> dP = model.first_piola_differential(F_[p], E, P.state_of(p));
-        K.col(j) = Eigen::Map<const Flat>(dP.data());
-      }
-      if (project) {
-        const Block Ks = Real(0.5) * (K + K.transpose());
-        Eigen::SelfAdjointEigenSolver<Block> eig(Ks);
-        if (eig.eigenvalues().minCoeff() < 0) {
-          K = eig.eigenvectors() * eig.eigenvalues().cwiseMax(Real(0)).asDiagonal() *
-              eig.eigenvectors().transpose();
-        }
-      }
-      K_[p] = K;
-    }
+    particles_.stress_divergence(out);
   }
 
   // out = M d + T^T h^2 sum_p V0 (K_p : dF_p) F^nT grad w (masked), d masked.
   void apply_hessian(const V& d, V& out) {
-    const Grid<Dim>& g = s_->grid;
-    const V dv = expand(d, false);
-    const Particles<Dim>& P = s_->particles;
-    const long n = static_cast<long>(F_.size());
-    Q_.resize(F_.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-    for (long p = 0; p < n; ++p) {
-      Mat<Dim> G = Mat<Dim>::Zero();
-      stencils_[p].for_each_node(g.geo, [&](long node, Real, const Vec<Dim>& grad,
-                                            const Vec<Dim>&) { G += dv[node] * grad.transpose(); });
-      const Mat<Dim> dF = h_ * G * Fn_[p];
-      Mat<Dim> dP;
-      Eigen::Map<Flat>(dP.data()) = K_[p] * Eigen::Map<const Flat>(dF.data());
-      Q_[p] = (h_ * P.V0[p]) * dP * Fn_[p].transpose();
-    }
     out.assign(mass_.size(), Vec<Dim>::Zero());
-    scatter_Q(out);
+    particles_.hessian_times(expand(d, false), h_, out);
     fold_ghosts(out);
     for (const long i : nodes_) out[i] = mask_[i].cwiseProduct(out[i] + mass_[i] * d[i]);
   }
 
   // The Jacobi preconditioner: 1 / diag(H) on the free components.
   void build_preconditioner() {
-    const Grid<Dim>& g = s_->grid;
-    const Particles<Dim>& P = s_->particles;
     V diag(mass_.size(), Vec<Dim>::Zero());
-    for (std::size_t p = 0; p < F_.size(); ++p) {
-      const Mat<Dim> FnT = Fn_[p].transpose();
-      stencils_[p].for_each_node(
-          g.geo, [&](long node, Real, const Vec<Dim>& grad, const Vec<Dim>&) {
-            const Vec<Dim> b = h_ * (FnT * grad);  // dF = e_a b^T for d = e_a at the node
-            for (int a = 0; a < Dim; ++a) {
-              Real sum = 0;
-              for (int c = 0; c < Dim; ++c) {
-                for (int e = 0; e < Dim; ++e) sum += b[c] * b[e] * K_[p](a + Dim * c, a + Dim * e);
-              }
-              diag[node][a] += h_ * P.V0[p] * sum;
-            }
-          });
-    }
+    particles_.hessian_diagonal(h_, diag);
     for (auto it = links_.rbegin(); it != links_.rend(); ++it) {
       diag[it->mirror] += diag[it->ghost];
     }
@@ -388,9 +276,7 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     }
   }
 
-  Real dot(const V& a, const V& b) const {
-    return node_dot<Dim>(nodes_, a, b);
-  }
+  Real dot(const V& a, const V& b) const { return node_dot<Dim>(nodes_, a, b); }
 
   // Preconditioned CG on H x = b to |r| <= tol; returns the iterations.
   long conjugate_gradients(const V& b, V& x, Real tol) {
@@ -416,13 +302,7 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     // times h V0 |grad w| ~ h V0 2 Dim / dx per particle.
     Real scale = 0;
     for (const long i : nodes_) scale += mass_[i] * (target_[i].norm() + base_[i].norm());
-    const Particles<Dim>& P = s_->particles;
-    for (std::size_t p = 0; p < P.size(); ++p) {
-      const ConstitutiveModel<Dim>& model = *s_->materials[P.material[p]];
-      const Real c = model.wave_speed();
-      scale += h_ * P.V0[p] * model.density() * c * c * (2 * Dim * s_->grid.geo.inv_dx) *
-               std::max(Real(1), Fn_[p].squaredNorm());
-    }
+    scale += particles_.stress_scale(h_);
     const Real floor = 64 * std::numeric_limits<Real>::epsilon() * std::max(scale, g0);
     Real gnorm = g0;
     while (gnorm > opt_.newton_tol * g0 && gnorm > floor) {
@@ -432,7 +312,7 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
       }
       ++stats_.newton;
       update_F(expand(u, true));
-      build_blocks(true);
+      particles_.build_blocks(true);
       build_preconditioner();
       V rhs = grad;
       for (const long i : nodes_) rhs[i] = -grad[i];
@@ -465,7 +345,8 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
         // psi(F) is known to P : dF with |dF| ~ eps |F| where F - I cancels at
         // small strain, and its terms of size rho c^2 |F|^2 cancel near rest
         // (neo-Hookean's mu/2 tr(F^T F) against mu ln J).
-        const Real noise = 64 * (std::numeric_limits<Real>::epsilon() * std::abs(E) + psi_noise_);
+        const Real noise =
+            64 * (std::numeric_limits<Real>::epsilon() * std::abs(E) + particles_.psi_noise());
         if (ls == 0 && E_new - E <= noise) {
           gradient(trial, grad_new);
           if (dot(grad_new, grad_new) < gnorm * gnorm) {
@@ -496,7 +377,7 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     // Grid energy before and after (kinetic with P2G's constrained velocities).
     V grad_full = zeros();
     stress_divergence(v, grad_full);
-    Real after = strain_energy(v), before = strain_energy_at_Fn();
+    Real after = strain_energy(v), before = particles_.strain_energy_at_Fn();
     for (const long i : nodes_) {
       after += Real(0.5) * mass_[i] * v[i].squaredNorm();
       before += Real(0.5) * mass_[i] * vn_[i].squaredNorm();
@@ -523,17 +404,12 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     s.collider_work += work;
 
     const Particles<Dim>& P = s.particles;
-    std::vector<Vec<Dim>> shift;
+    V shift;
     if (newmark_) {
       // F^n+1 = (I + dt (v^n + v^n+1)/2 grad w^T) F^n; x^n+1 = x^n + dt (v^n + v^n+1)/2,
       // the transfer's G2P moving by dt v^n+1 and the difference added after.
       for (const long i : nodes_) g.v[i] = Real(0.5) * (base_[i] + v[i]);
-      shift.assign(P.size(), Vec<Dim>::Zero());
-      for (std::size_t p = 0; p < P.size(); ++p) {
-        stencils_[p].for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
-          shift[p] += (dt / 2 * w) * (base_[node] - v[node]);
-        });
-      }
+      particles_.interpolate_difference(base_, v, dt / 2, shift);
     } else {
       for (const long i : nodes_) g.v[i] = v[i];
     }
@@ -552,20 +428,11 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
     stepper.nonlocal_update(s);
     stepper.constitutive_update(s, dt);
   }
-  Real strain_energy_at_Fn() const {
-    const Particles<Dim>& P = s_->particles;
-    Real sum = 0;
-    for (std::size_t p = 0; p < Fn_.size(); ++p) {
-      sum += P.V0[p] * s_->materials[P.material[p]]->energy_density(Fn_[p], P.state_of(p));
-    }
-    return sum;
-  }
-
   bool newmark_;
   ImplicitOptions opt_;
   State<Dim>* s_ = nullptr;
   Real h_ = 0;
-  Real psi_noise_ = 0;       // eps sum_p V0 |P| |F| at the last gradient
+  ImplicitParticles<Dim, Kernel> particles_;
   std::vector<long> nodes_;  // the active nodes
   std::vector<Real> mass_;   // m_i, folded; 0 at ghosts that follow a mirror
   V target_;                 // v~
@@ -577,9 +444,6 @@ class ImplicitSolveT final : public ImplicitSolve<Dim> {
   V inv_diag_;
   std::vector<std::uint8_t> collider_;
   std::vector<Link> links_;
-  std::vector<StencilT> stencils_;
-  std::vector<Mat<Dim>> Fn_, F_, Q_;
-  std::vector<Block, Eigen::aligned_allocator<Block>> K_;
 };
 
 template <int Dim>
