@@ -91,7 +91,7 @@ TEST(ImplicitThreads, HangingBlock2D) {
 }
 
 TEST(ImplicitThreads, HangingBlock3D) {
-  ExpectSameForOneAndTwoThreads<3>(testing::scene_from_toml(HangingBlock(3, 20)), 1, 5);
+  ExpectSameForOneAndTwoThreads<3>(testing::scene_from_toml(HangingBlock(3, 16)), 1, 5);
 }
 
 TEST(ImplicitThreads, ManufacturedSolutionWithBodyForce2D) {
