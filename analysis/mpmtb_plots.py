@@ -125,7 +125,8 @@ KERNEL_LINESTYLES = {"linear": ":", "quadratic": "-", "cubic": "-.",
                      "gimp": (0, (5, 1))}
 KERNEL_HATCHES = {"linear": "..", "quadratic": "", "cubic": "//", "gimp": "xx"}
 # Time integrators (issue 19): a method of the suites is transfer x kernel x
-# integrator; explicit is the default and keeps the plain "transfer-kernel" name.
+# integrator; explicit is the default and keeps the plain "transfer-kernel"
+# name.
 INTEGRATORS = ("explicit", "backward-euler", "newmark")
 INTEGRATOR_MARKERS = {"explicit": "o", "backward-euler": "s", "newmark": "^"}
 INTEGRATOR_SHORT = {"explicit": "", "backward-euler": "BE", "newmark": "NM"}

@@ -145,7 +145,8 @@ def plot_convergence(suites):
 
 def stable_text(row):
     """The largest stable CFL of a stable_cfl.csv row as shown: ">=" where no
-    tried value failed (the implicit integrators), "-" where none was stable."""
+    tried value failed (the implicit integrators), "-" where none was
+    stable."""
     c = num(row, "stable_cfl")
     if not np.isfinite(c):
         return "-"
@@ -162,7 +163,8 @@ def plot_stability_map(suites):
     grid = np.full((len(methods), len(columns)), np.nan)
     text = [["-"] * len(columns) for _ in methods]
     for r in rows:
-        i, j = methods.index(method_key(r)), columns.index((r["case"], r["ppc"]))
+        i = methods.index(method_key(r))
+        j = columns.index((r["case"], r["ppc"]))
         grid[i, j] = num(r, "stable_cfl")
         text[i][j] = stable_text(r)
     fig, ax = plt.subplots(figsize=(max(5.5, 1.3 + 0.9 * len(columns)),
@@ -256,7 +258,8 @@ def plot_failure_modes(suites):
 # ------------------------------------------------------- speed-accuracy --
 
 def series_label(row):
-    """A work-precision series: the method, with its CFL for an implicit one."""
+    """A work-precision series: the method, with its CFL for an implicit
+    one."""
     name = method_name(row)
     if mp.integrator_of(row) == "explicit":
         return name
