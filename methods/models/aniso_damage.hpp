@@ -188,6 +188,22 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
     if (fiber_E_ == 0) return m_.P(F, q);
     return m_.P(F, q) + fiber_degradation(damage(q)) * fiber_piola(F, q);
   }
+  // dP = (dP/dF) : dF at fixed d (the implicit integrators' Hessian): the
+  // matrix's (models/damage.hpp) plus the degraded fibres'. With u = F a0,
+  // du = dF a0 and d lambda = u . du / lambda, for a stretched fibre
+  //   dP_f = fiber_E [(u . du) / lambda^3 u + (1 - 1 / lambda) du] a0^T.
+  Mat<Dim> dP(const Mat<Dim>& F, const Mat<Dim>& dF, const Real* q) const {
+    if (fiber_E_ == 0) return m_.dP(F, dF, q);
+    Mat<Dim> dP_f = Mat<Dim>::Zero();
+    for (int f = 0; f < kFamilies; ++f) {
+      const Vec<Dim> a0 = reference_fiber(q, f), u = F * a0, du = dF * a0;
+      const Real stretch = u.norm();
+      if (a0.squaredNorm() == 0 || !(stretch > 1)) continue;
+      dP_f += fiber_E_ * (u.dot(du) / (stretch * stretch * stretch) * u + (1 - 1 / stretch) * du) *
+              a0.transpose();
+    }
+    return m_.dP(F, dF, q) + fiber_degradation(damage(q)) * dP_f;
+  }
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
     if (fiber_E_ == 0) return m_.tau(F, q);
     return m_.tau(F, q) + fiber_degradation(damage(q)) * fiber_kirchhoff(F, q);

@@ -33,6 +33,8 @@ using testing::RandomMatrix;
 std::map<std::string, Real> Params(const std::string& model) {
   std::map<std::string, Real> v = {{"E", 1000}, {"nu", 0.3}, {"density", 10}};
   if (model == "damage" || model == "aniso-damage") v["sigma_crit"] = 10;
+  // Stiff fibres, so that their stress and its derivative count in the checks.
+  if (model == "aniso-damage") v["fiber_E"] = 2000, v["alpha"] = 2;
   return v;
 }
 
@@ -83,6 +85,7 @@ TEST(ImplicitModels, FirstPiolaDifferentialMatchesFiniteDifferences3D) {
 // particle layer, so that the walls' ghosts, the masks and the pins all enter.
 std::string SceneText(int dim, const std::string& model, const std::string& kernel) {
   std::string extra = Params(model).count("sigma_crit") ? "sigma_crit = 10.0\n" : "";
+  if (model == "aniso-damage") extra += "fiber_E = 2000.0\nalpha = 2.0\n";
   return "[scene]\nname = \"implicit\"\ndim = " + std::to_string(dim) +
          "\ndims = [1, 2, 3]\n"
          "[domain]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\n"
