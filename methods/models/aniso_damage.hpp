@@ -44,6 +44,11 @@
 // so that A a = a for a single family and A b = (1 + alpha) b for b normal to
 // it: tension across the fibres drives damage (1 + alpha)^2 times as hard as
 // the same tension along them (the material splits along its grain).
+// (AnisoMPM's own driver, as its public implementation computes it: phi =
+// (A sigma+ : sigma+ A) / sigma_crit^2 with A = I + alpha a a^T, alpha in
+// [-1, inf), and the isotropic lap d; for alpha near -1 it is, like this one
+// for large alpha, the normal stress on the planes that contain the fibres.
+// Alone it turns a crack only part of the way to the fibres: cases/README.md.)
 // Driver: sigma~ = A sigma A (sigma the undamaged Cauchy stress, fibre part
 // included), phi = (largest principal value of sigma~) / sigma_crit,
 // D~ = zeta <phi - 1>, and the rate law and the linearly implicit update of
