@@ -115,15 +115,17 @@ def save_figure(fig, path):
 
 TRANSFERS = ("pic", "flip", "apic", "mls", "tpic", "polypic", "xpic", "aflip",
              "asflip")
-KERNELS = ("linear", "quadratic", "cubic", "gimp")
+KERNELS = ("linear", "quadratic", "cubic", "gimp", "cpgimp", "cpdi")
 TRANSFER_COLOURS = {"pic": "tab:blue", "flip": "tab:orange",
                     "apic": "tab:green", "mls": "tab:red",
                     "tpic": "tab:purple", "polypic": "tab:brown",
                     "xpic": "tab:pink", "aflip": "tab:olive",
                     "asflip": "tab:cyan"}
 KERNEL_LINESTYLES = {"linear": ":", "quadratic": "-", "cubic": "-.",
-                     "gimp": (0, (5, 1))}
-KERNEL_HATCHES = {"linear": "..", "quadratic": "", "cubic": "//", "gimp": "xx"}
+                     "gimp": (0, (5, 1)), "cpgimp": (0, (5, 1, 1, 1)),
+                     "cpdi": (0, (8, 2))}
+KERNEL_HATCHES = {"linear": "..", "quadratic": "", "cubic": "//", "gimp": "xx",
+                  "cpgimp": "++", "cpdi": "--"}
 # Time integrators (issue 19): a method of the suites is transfer x kernel x
 # integrator; explicit is the default and keeps the plain "transfer-kernel"
 # name.

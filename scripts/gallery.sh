@@ -1,7 +1,8 @@
 #!/usr/bin/env bash
 # Regenerates results/gallery/: runs the canonical scenes with ParaView frames
 # into build/gallery-runs/ (not kept in git) and draws them with
-# analysis/render.py. About 6 minutes on 2 cores, most of it the pinned blocks.
+# analysis/render.py. About 9 minutes on 2 cores, most of it the pinned blocks
+# and fiber_tension at 128 cells.
 # Expects the build of scripts/build.sh (build/cases/mpmtb).
 set -euo pipefail
 cd "$(dirname "$0")/.."
@@ -35,12 +36,13 @@ render "$runs/pinned_block" --size 600x520 --out "$runs/grain_none.png"
 /usr/bin/python3 analysis/side_by_side.py "$out/pinned_block_grain.png" \
   "isotropic (damage)=$runs/grain_none.png" "grain along x=$runs/grain_x.png" \
   "grain along y=$runs/grain_y.png" >/dev/null
-# fiber_tension: the crack against the fibre angle (2D, 64 cells).
+# fiber_tension: the crack against the fibre angle (2D, 128 cells, issue 20's
+# acceptance grid; about a minute each).
 panels=()
 for theta in 0 30 60; do
   c=$(/usr/bin/python3 -c "import math; print(math.cos(math.radians($theta)))")
   s=$(/usr/bin/python3 -c "import math; print(math.sin(math.radians($theta)))")
-  "$mpmtb" run fiber_tension --set "bodies.0.fiber=[$c,$s,0]" --frames-dt 0.1 --quiet \
+  "$mpmtb" run fiber_tension --cells 128 --set "bodies.0.fiber=[$c,$s,0]" --frames-dt 0.1 --quiet \
     --out "$runs/fiber_tension_$theta"
   render "$runs/fiber_tension_$theta" --field damage --size 450x400 --out "$runs/fiber_$theta.png"
   panels+=("fibres at $theta deg=$runs/fiber_$theta.png")

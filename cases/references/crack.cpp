@@ -6,6 +6,7 @@
 #include <algorithm>
 #include <cmath>
 #include <numbers>
+#include <vector>
 
 #include "core/errors.hpp"
 #include "scene.hpp"
@@ -19,11 +20,56 @@ CrackGeometry<Dim>::CrackGeometry(const Scene& scene) {
   threshold_ =
       params.optional("threshold", 0.5, Range{[](Real t) { return t > 0 && t <= 1; }, "in (0, 1]"});
   radius_ = params.optional("radius", 0, Range::non_negative());
+  connected_ = params.optional("connected", 0,
+                               Range{[](Real c) { return c == 0 || c == 1; }, "0 or 1"}) == 1;
   params.reject_unknown();
+  const BodySpec& body = scene.bodies.front();
   Vec3 lo, hi;
-  scene.bodies.front().bounds(lo, hi);
+  body.bounds(lo, hi);
   center_ = (lo + hi) / 2;
   if (Dim == 3) thickness_ = hi[2] - lo[2];
+  // The seed region: the cut-out (or the centre) and two cells round it, which
+  // the stretched plate's damage next to the cut reaches.
+  h_ = scene.dx();
+  const bool cut = (body.cut_max.array() > body.cut_min.array()).head<2>().all();
+  seed_lo_ = (cut ? body.cut_min : center_).head<2>().array() - 2 * h_;
+  seed_hi_ = (cut ? body.cut_max : center_).head<2>().array() + 2 * h_;
+}
+
+// Keeps in `in` only the particles in cells of size h_ (x-y) joined, through
+// cells sharing a side or a corner, to a cell that meets the seed box.
+template <int Dim>
+void CrackGeometry<Dim>::keep_connected(const std::vector<Eigen::Vector2d>& x,
+                                        std::vector<char>& in) const {
+  Eigen::Vector2d lo = seed_lo_, hi = seed_hi_;
+  for (std::size_t i = 0; i < x.size(); ++i) lo = lo.cwiseMin(x[i]), hi = hi.cwiseMax(x[i]);
+  const auto cell = [&](const Eigen::Vector2d& y) {
+    return Eigen::Vector2i(static_cast<int>(std::floor((y[0] - lo[0]) / h_)),
+                           static_cast<int>(std::floor((y[1] - lo[1]) / h_)));
+  };
+  const Eigen::Vector2i n = cell(hi) + Eigen::Vector2i::Ones();
+  const auto at = [&](const Eigen::Vector2i& c) {
+    return static_cast<std::size_t>(c[1]) * n[0] + c[0];
+  };
+  const std::size_t cells = static_cast<std::size_t>(n[0]) * n[1];
+  std::vector<char> occupied(cells, 0), reached(cells, 0);
+  for (const auto& y : x) occupied[at(cell(y))] = 1;
+  std::vector<Eigen::Vector2i> todo;
+  const Eigen::Vector2i s0 = cell(seed_lo_), s1 = cell(seed_hi_);
+  for (int j = s0[1]; j <= s1[1]; ++j)
+    for (int i = s0[0]; i <= s1[0]; ++i)
+      if (occupied[at({i, j})]) reached[at({i, j})] = 1, todo.push_back({i, j});
+  while (!todo.empty()) {
+    const Eigen::Vector2i c = todo.back();
+    todo.pop_back();
+    for (int dj = -1; dj <= 1; ++dj)
+      for (int di = -1; di <= 1; ++di) {
+        const Eigen::Vector2i m = c + Eigen::Vector2i(di, dj);
+        if (m.minCoeff() < 0 || m[0] >= n[0] || m[1] >= n[1]) continue;
+        if (occupied[at(m)] && !reached[at(m)]) reached[at(m)] = 1, todo.push_back(m);
+      }
+  }
+  for (std::size_t i = 0; i < x.size(); ++i) in[i] = reached[at(cell(x[i]))];
 }
 
 template <int Dim>
@@ -51,12 +97,21 @@ std::vector<Real> CrackGeometry<Dim>::sample(const State<Dim>& s, const Diagnost
   dissipated_ = d.dissipated;
   if constexpr (Dim >= 2) {
     const auto& P = s.particles;
-    Real V = 0, count = 0;
-    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    std::vector<std::size_t> crack;
+    std::vector<Eigen::Vector2d> x;
     for (std::size_t p = 0; p < P.size(); ++p) {
       if (!counts(P, p)) continue;
-      V += P.V0[p], count += 1;
-      mean += P.V0[p] * Eigen::Vector2d(P.x[p][0], P.x[p][1]);
+      crack.push_back(p);
+      x.emplace_back(P.x[p][0], P.x[p][1]);
+    }
+    std::vector<char> in(crack.size(), 1);
+    if (connected_ && !crack.empty()) keep_connected(x, in);
+    Real V = 0, count = 0;
+    Eigen::Vector2d mean = Eigen::Vector2d::Zero();
+    for (std::size_t i = 0; i < crack.size(); ++i) {
+      if (!in[i]) continue;
+      V += P.V0[crack[i]], count += 1;
+      mean += P.V0[crack[i]] * x[i];
     }
     count_ = count;
     if (count < 2) {
@@ -65,10 +120,10 @@ std::vector<Real> CrackGeometry<Dim>::sample(const State<Dim>& s, const Diagnost
     }
     mean /= V;
     Eigen::Matrix2d M = Eigen::Matrix2d::Zero();
-    for (std::size_t p = 0; p < P.size(); ++p) {
-      if (!counts(P, p)) continue;
-      const Eigen::Vector2d r = Eigen::Vector2d(P.x[p][0], P.x[p][1]) - mean;
-      M += P.V0[p] * r * r.transpose();
+    for (std::size_t i = 0; i < crack.size(); ++i) {
+      if (!in[i]) continue;
+      const Eigen::Vector2d r = x[i] - mean;
+      M += P.V0[crack[i]] * r * r.transpose();
     }
     M /= V;
     const Eigen::SelfAdjointEigenSolver<Eigen::Matrix2d> eig(M);  // ascending
@@ -85,9 +140,9 @@ std::vector<Real> CrackGeometry<Dim>::sample(const State<Dim>& s, const Diagnost
 
 template <int Dim>
 nlohmann::json CrackGeometry<Dim>::measured() const {
-  return {{"crack_angle_deg", angle_}, {"crack_length", length_},     {"band_width", width_},
-          {"dissipated", dissipated_}, {"damaged_particles", count_}, {"threshold", threshold_},
-          {"radius", radius_}};
+  return {{"crack_angle_deg", angle_}, {"crack_length", length_},        {"band_width", width_},
+          {"dissipated", dissipated_}, {"damaged_particles", count_},    {"threshold", threshold_},
+          {"radius", radius_},         {"connected", connected_ ? 1 : 0}};
 }
 
 template <int Dim>

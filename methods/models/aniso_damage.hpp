@@ -44,6 +44,11 @@
 // so that A a = a for a single family and A b = (1 + alpha) b for b normal to
 // it: tension across the fibres drives damage (1 + alpha)^2 times as hard as
 // the same tension along them (the material splits along its grain).
+// (AnisoMPM's own driver, as its public implementation computes it: phi =
+// (A sigma+ : sigma+ A) / sigma_crit^2 with A = I + alpha a a^T, alpha in
+// [-1, inf), and the isotropic lap d; for alpha near -1 it is, like this one
+// for large alpha, the normal stress on the planes that contain the fibres.
+// Alone it turns a crack only part of the way to the fibres: cases/README.md.)
 // Driver: sigma~ = A sigma A (sigma the undamaged Cauchy stress, fibre part
 // included), phi = (largest principal value of sigma~) / sigma_crit,
 // D~ = zeta <phi - 1>, and the rate law and the linearly implicit update of
@@ -187,6 +192,22 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
   Mat<Dim> P(const Mat<Dim>& F, const Real* q) const {
     if (fiber_E_ == 0) return m_.P(F, q);
     return m_.P(F, q) + fiber_degradation(damage(q)) * fiber_piola(F, q);
+  }
+  // dP = (dP/dF) : dF at fixed d (the implicit integrators' Hessian): the
+  // matrix's (models/damage.hpp) plus the degraded fibres'. With u = F a0,
+  // du = dF a0 and d lambda = u . du / lambda, for a stretched fibre
+  //   dP_f = fiber_E [(u . du) / lambda^3 u + (1 - 1 / lambda) du] a0^T.
+  Mat<Dim> dP(const Mat<Dim>& F, const Mat<Dim>& dF, const Real* q) const {
+    if (fiber_E_ == 0) return m_.dP(F, dF, q);
+    Mat<Dim> dP_f = Mat<Dim>::Zero();
+    for (int f = 0; f < kFamilies; ++f) {
+      const Vec<Dim> a0 = reference_fiber(q, f), u = F * a0, du = dF * a0;
+      const Real stretch = u.norm();
+      if (a0.squaredNorm() == 0 || !(stretch > 1)) continue;
+      dP_f += fiber_E_ * (u.dot(du) / (stretch * stretch * stretch) * u + (1 - 1 / stretch) * du) *
+              a0.transpose();
+    }
+    return m_.dP(F, dF, q) + fiber_degradation(damage(q)) * dP_f;
   }
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
     if (fiber_E_ == 0) return m_.tau(F, q);

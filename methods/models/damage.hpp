@@ -151,6 +151,23 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     const Real g = degradation(damage(q));
     return J >= 1 ? Mat<Dim>(g * (P_dev + P_vol)) : Mat<Dim>(g * P_dev + P_vol);
   }
+  // dP = (dP/dF) : dF at fixed d (the implicit integrators' Hessian), the
+  // differential of P above with t = F^-T : dF = d ln J, ds = (2/dim) s t and
+  // d(F^-T) = -F^-T dF^T F^-T (Bonet & Wood 2008, sec. 6.4.3):
+  //   dP_dev = mu (dF - (2/dim) s t F^-T + s F^-T dF^T F^-T),
+  //   dP_vol = ((2/dim) mu s + lambda) t F^-T - (mu (s - 1) + lambda ln J) F^-T dF^T F^-T,
+  // degraded as P is (their sum is neo-Hookean's dP). At J = 1 the branch is P's.
+  Mat<Dim> dP(const Mat<Dim>& F, const Mat<Dim>& dF, const Real* q) const {
+    const Real J = F.determinant(), logJ = std::log(J), s = pow_2_over_dim(J, logJ);
+    const Mat<Dim> F_invT = F.inverse().transpose();
+    const Mat<Dim> dF_invT = -F_invT * dF.transpose() * F_invT;
+    const Real t = F_invT.cwiseProduct(dF).sum(), ds = Real(2) / Dim * s * t;
+    const Mat<Dim> dP_dev = c_.mu * (dF - ds * F_invT - s * dF_invT);
+    const Mat<Dim> dP_vol =
+        (c_.mu * ds + c_.lambda * t) * F_invT + (c_.mu * (s - 1) + c_.lambda * logJ) * dF_invT;
+    const Real g = degradation(damage(q));
+    return J >= 1 ? Mat<Dim>(g * (dP_dev + dP_vol)) : Mat<Dim>(g * dP_dev + dP_vol);
+  }
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
     return tau_with(F, degradation(damage(q)));
   }

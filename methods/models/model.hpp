@@ -100,11 +100,10 @@ class ModelBase : public ConstitutiveModel<Dim> {
  public:
   Real energy_density(const Mat<Dim>& F, const Real* q) const override { return self().psi(F, q); }
   Mat<Dim> first_piola(const Mat<Dim>& F, const Real* q) const override { return self().P(F, q); }
-  // The model's own dP(F, dF, q) where it has one; otherwise the central
-  // difference of P along dF (step 1e-6 relative), second-order accurate: the
-  // fallback of the models whose stress derivative is not written out (sand,
-  // damage, aniso-damage), enough for Newton's direction, which the line
-  // search on the energy safeguards.
+  // The model's own dP(F, dF, q) where it has one (every built-in model);
+  // otherwise the central difference of P along dF (step 1e-6 relative),
+  // second-order accurate: enough for Newton's direction, which the line search
+  // on the energy safeguards, for a new model whose derivative is not written out.
   Mat<Dim> first_piola_differential(const Mat<Dim>& F, const Mat<Dim>& dF,
                                     const Real* q) const override {
     if constexpr (requires { self().dP(F, dF, q); }) {

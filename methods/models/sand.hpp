@@ -154,6 +154,43 @@ class Sand final : public ModelBase<Dim, Sand<Dim>> {
     const SignedSvd<Dim> svd = signed_svd<Dim>(F);
     return svd.U * kirchhoff_principal(log_strain(svd.sigma)).asDiagonal() * svd.U.transpose();
   }
+  // dP = (dP/dF) : dF of the elastic part (the implicit integrators' Hessian; the
+  // return map runs after the solve). P = U diag(p) V^T with p_i = tau_i / sigma_i
+  // is isotropic, so in the principal frames, G = U^T dF V and dP = U H V^T
+  // (Irving, Teran & Fedkiw 2004, "Invertible finite elements for robust
+  // simulation of large deformation", the diagonalised elasticity tensor):
+  //   H_ii = sum_j dp_i/dsigma_j G_jj,  dp_i/dsigma_j = (2 mu delta_ij + lambda)
+  //          / (sigma_i sigma_j) - delta_ij tau_i / sigma_i^2,
+  //   (H_ij, H_ji) = 1/2 [(a + b) (G_ij, G_ji) + (a - b) (G_ji, G_ij)], i != j,
+  //   a = (p_i - p_j) / (sigma_i - sigma_j), b = (p_i + p_j) / (sigma_i + sigma_j),
+  // a written without the cancellation at sigma_i = sigma_j:
+  //   a = 2 mu (ln sigma_i - ln sigma_j) / ((sigma_i - sigma_j) sigma_i) - tau_j / (sigma_i
+  //   sigma_j),
+  // with (ln sigma_i - ln sigma_j) / (sigma_i - sigma_j) = log1p(x) / (x sigma_j),
+  // x = (sigma_i - sigma_j) / sigma_j (1 / sigma_j at x = 0).
+  Mat<Dim> dP(const Mat<Dim>& F, const Mat<Dim>& dF, const Real*) const {
+    const SignedSvd<Dim> svd = signed_svd<Dim>(F);
+    const Vec<Dim>& s = svd.sigma;
+    const Vec<Dim> tau = kirchhoff_principal(log_strain(s));
+    const Mat<Dim> G = svd.U.transpose() * dF * svd.V;
+    Mat<Dim> H;
+    for (int i = 0; i < Dim; ++i) {
+      Real h = -tau[i] / (s[i] * s[i]) * G(i, i);
+      for (int j = 0; j < Dim; ++j) {
+        h += ((i == j ? 2 * c_.mu : Real(0)) + c_.lambda) / (s[i] * s[j]) * G(j, j);
+      }
+      H(i, i) = h;
+      for (int j = i + 1; j < Dim; ++j) {
+        const Real x = (s[i] - s[j]) / s[j];
+        const Real log_quotient = x == 0 ? 1 / s[j] : std::log1p(x) / (x * s[j]);
+        const Real a = 2 * c_.mu * log_quotient / s[i] - tau[j] / (s[i] * s[j]);
+        const Real b = (tau[i] / s[i] + tau[j] / s[j]) / (s[i] + s[j]);
+        H(i, j) = Real(0.5) * ((a + b) * G(i, j) + (a - b) * G(j, i));
+        H(j, i) = Real(0.5) * ((a - b) * G(i, j) + (a + b) * G(j, i));
+      }
+    }
+    return svd.U * H * svd.V.transpose();
+  }
 
   // The return map of one particle (Algorithm 2): F is the trial elastic part
   // on entry and the projected one on exit. Trial states inside the cone, and

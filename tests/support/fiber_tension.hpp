@@ -8,6 +8,7 @@
 
 #include <cmath>
 #include <filesystem>
+#include <functional>
 #include <numbers>
 #include <string>
 #include <vector>
@@ -53,7 +54,13 @@ inline std::string isotropic_fiber_tension_text() {
 inline RunOutcome run_fiber_tension(const std::string& text, const std::string& label,
                                     const Overrides& o) {
   const Scene scene = scene_from_text(text, "fiber_tension", o);
-  const auto dir = std::filesystem::temp_directory_path() / ("mpmtb_fiber_tension_" + label);
+  // Runs of one label with other overrides (the end time, the sets) get their
+  // own folder: ctest runs the tests in parallel.
+  std::string key = std::to_string(o.t_end.value_or(0));
+  for (const std::string& s : o.set) key += ";" + s;
+  const auto dir = std::filesystem::temp_directory_path() /
+                   ("mpmtb_fiber_tension_" + label + "_" +
+                    std::to_string(std::hash<std::string>{}(key) % 1000003));
   const RunOutcome r = run_scene(scene, dir, {.threads = 1});
   EXPECT_EQ(r.status, "ok") << label << ": " << r.reason;
   std::filesystem::remove_all(dir);

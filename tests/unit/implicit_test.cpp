@@ -11,6 +11,7 @@
 // * pinned nodes stay at rest in the solve at a large step.
 #include <gtest/gtest.h>
 
+#include <algorithm>
 #include <map>
 #include <random>
 #include <string>
@@ -32,6 +33,8 @@ using testing::RandomMatrix;
 std::map<std::string, Real> Params(const std::string& model) {
   std::map<std::string, Real> v = {{"E", 1000}, {"nu", 0.3}, {"density", 10}};
   if (model == "damage" || model == "aniso-damage") v["sigma_crit"] = 10;
+  // Stiff fibres, so that their stress and its derivative count in the checks.
+  if (model == "aniso-damage") v["fiber_E"] = 2000, v["alpha"] = 2;
   return v;
 }
 
@@ -43,8 +46,16 @@ void CheckModelDifferential() {
     const auto model = make_model<Dim>(info.name, params);
     std::vector<Real> q(std::max(1, model->state_size()), 0);
     model->initial_state(q.data());
+    // The damage models also at a damaged state (P degraded in tension only).
+    const auto names = model->state_names();
+    const auto damage = std::find(names.begin(), names.end(), "damage");
     for (int trial = 0; trial < 20; ++trial) {
-      const Mat<Dim> F = RandomF<Dim>(gen, 0.3, 0.3);
+      if (damage != names.end()) q[damage - names.begin()] = trial % 2 ? 0.6 : 0;
+      // Trials 0 and 2: repeated singular values (the isotropic models' 0/0
+      // limits), all equal and (3D) two of three.
+      Mat<Dim> F = RandomF<Dim>(gen, 0.3, 0.3);
+      if (trial == 0 || trial == 2) F = Real(1.1) * Mat<Dim>::Identity();
+      if (trial == 2) F(Dim - 1, Dim - 1) = 0.95;
       const Mat<Dim> dF = RandomMatrix<Dim>(gen);
       const Real h = 1e-6;
       const Mat<Dim> fd =
@@ -74,6 +85,7 @@ TEST(ImplicitModels, FirstPiolaDifferentialMatchesFiniteDifferences3D) {
 // particle layer, so that the walls' ghosts, the masks and the pins all enter.
 std::string SceneText(int dim, const std::string& model, const std::string& kernel) {
   std::string extra = Params(model).count("sigma_crit") ? "sigma_crit = 10.0\n" : "";
+  if (model == "aniso-damage") extra += "fiber_E = 2000.0\nalpha = 2.0\n";
   return "[scene]\nname = \"implicit\"\ndim = " + std::to_string(dim) +
          "\ndims = [1, 2, 3]\n"
          "[domain]\nmin = [0.0, 0.0, 0.0]\nmax = [1.0, 1.0, 1.0]\n"
