@@ -2,7 +2,7 @@
 # The main job: installs what is missing, builds, runs the comparison suites and
 # regenerates the figures and results/README.md.
 #
-#   bash scripts/suite.sh          quick default (about 10 minutes on 2 cores after
+#   bash scripts/suite.sh          quick default (about 11 minutes on 2 cores after
 #                                  the build): the work-precision diagrams (every
 #                                  run timed alone), the quick convergence and
 #                                  stability suites, the figures
