@@ -57,6 +57,9 @@ heavy+=':*FreeFlightConservesMassAndMomentum/2d*:*FreeFlightConservesMassAndMome
 # CPDI's 3D steps (64 nodes per particle, node by node: 6 to 44 s each here)
 # and its 1D thread-count runs: the 1D and 2D steps run the same kernel code.
 heavy+=':AllCombinations/StepTest.*/3d_*_cpdi:*ThreadCountDoesNotChangeTheResult/1d_*_cpdi'
+# The implicit solve's 3D thread-count run (1.6 s in Release): the 2D ones run
+# the same scatter code.
+heavy+=':ImplicitThreads.HangingBlock3D'
 # One process per shard, not one per test: each sanitized process costs about a
 # second to start, which over a thousand tests would dominate the stage.
 cd build-asan/tests
