@@ -105,7 +105,9 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     const long rows = g.active_rows();
     const bool parallel = g.active_nodes() >= kParallelMinimum;
     const Vec<Dim> gravity = s.gravity;
-    for_each_active_node(g, [&](long i) { g.f[i] += g.m[i] * gravity; });
+    // Skipped without gravity: adding m_i 0 changes no value (only -0 to +0).
+    if (gravity != Vec<Dim>::Zero())
+      for_each_active_node(g, [&](long i) { g.f[i] += g.m[i] * gravity; });
     s.walls.fold(g);
     Real rx = 0, ry = 0, rz = 0;  // reaction of the pinned nodes
 #pragma omp parallel for schedule(static) reduction(+ : rx, ry, rz) if (parallel)

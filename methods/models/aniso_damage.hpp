@@ -210,8 +210,12 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
     return m_.dP(F, dF, q) + fiber_degradation(damage(q)) * dP_f;
   }
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
-    if (fiber_E_ == 0) return m_.tau(F, q);
-    return m_.tau(F, q) + fiber_degradation(damage(q)) * fiber_kirchhoff(F, q);
+    return tau_given_log(F, std::log(F.determinant()), q);
+  }
+  // tau with ln J given, as damage's (ModelBase takes a batch's logarithms at once).
+  Mat<Dim> tau_given_log(const Mat<Dim>& F, Real logJ, const Real* q) const {
+    if (fiber_E_ == 0) return m_.tau_given_log(F, logJ, q);
+    return m_.tau_given_log(F, logJ, q) + fiber_degradation(damage(q)) * fiber_kirchhoff(F, q);
   }
 
   // The structural tensor A = I + alpha sum_f (I - a_f a_f^T) of the current fibres.
@@ -225,7 +229,10 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
   }
   // sigma~ = A sigma A, sigma the undamaged Cauchy stress (fibres included).
   Mat<Dim> driving_stress(const Mat<Dim>& F, const Real* q) const {
-    Mat<Dim> sigma = m_.undamaged_cauchy(F);
+    return driving_stress(F, std::log(F.determinant()), q);
+  }
+  Mat<Dim> driving_stress(const Mat<Dim>& F, Real logJ, const Real* q) const {
+    Mat<Dim> sigma = m_.undamaged_cauchy(F, logJ);
     if (fiber_E_ > 0) sigma += fiber_kirchhoff(F, q) / F.determinant();
     const Mat<Dim> A = structural_tensor(q);
     return A * sigma * A;
@@ -237,11 +244,15 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
   // Writes the current fibres a_f = F a0_f / |F a0_f|, then updates the damage at
   // fixed F as models/damage.hpp does, driven by sigma~ instead of sigma.
   void project(Mat<Dim>& F, Real* q, Real dt) const {
+    project_given_log(F, std::log(F.determinant()), q, dt);
+  }
+  // The same with ln J given (ModelBase::return_map takes a batch's logarithms).
+  void project_given_log(Mat<Dim>& F, Real logJ, Real* q, Real dt) const {
     advect_fibers(F, q);
-    if (alpha_ == 0 && fiber_E_ == 0) return m_.project(F, q, dt);  // `damage` exactly
+    if (alpha_ == 0 && fiber_E_ == 0) return m_.project_given_log(F, logJ, q, dt);  // `damage`
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
-    const Real d_new = m_.advanced_damage(d_old, stress_excess(F, q), q, dt);
+    const Real d_new = m_.advanced_damage(d_old, stress_excess(F, logJ, q), q, dt);
     if (!(d_new > d_old)) return;
     q[kDissipated] += (m_.degradation(d_old) - m_.degradation(d_new)) * m_.split(F).plus +
                       (fiber_degradation(d_old) - fiber_degradation(d_new)) * fiber_energy(F, q);
@@ -285,8 +296,8 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
     }
   }
   // largest eig(sigma~) - sigma_crit, with the Gershgorin shortcut of models/damage.hpp.
-  Real stress_excess(const Mat<Dim>& F, const Real* q) const {
-    return Matrix::eigenvalue_excess(driving_stress(F, q), m_.sigma_crit());
+  Real stress_excess(const Mat<Dim>& F, Real logJ, const Real* q) const {
+    return Matrix::eigenvalue_excess(driving_stress(F, logJ, q), m_.sigma_crit());
   }
 
   Matrix m_;

@@ -171,15 +171,28 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
     return tau_with(F, degradation(damage(q)));
   }
+  // tau with ln J given: the stress pass takes the logarithms of a batch at once
+  // (ModelBase::kirchhoff_times_volume).
+  Mat<Dim> tau_given_log(const Mat<Dim>& F, Real logJ, const Real* q) const {
+    return tau_with(F, logJ, degradation(damage(q)));
+  }
   // Undamaged Cauchy stress sigma = tau(F, d = 0) / J: the damage driver.
-  Mat<Dim> undamaged_cauchy(const Mat<Dim>& F) const { return tau_with(F, 1) / F.determinant(); }
+  Mat<Dim> undamaged_cauchy(const Mat<Dim>& F) const {
+    return undamaged_cauchy(F, std::log(F.determinant()));
+  }
+  Mat<Dim> undamaged_cauchy(const Mat<Dim>& F, Real logJ) const {
+    return tau_with(F, logJ, 1) / F.determinant();
+  }
   Real max_principal_stress(const Mat<Dim>& F) const {
     return max_symmetric_eigenvalue(undamaged_cauchy(F));
   }
   // sigma_max - sigma_crit, or a negative number when a cheap bound shows that
   // sigma_max stays below sigma_crit (most particles, most steps).
   Real stress_excess(const Mat<Dim>& F) const {
-    return eigenvalue_excess(undamaged_cauchy(F), sigma_crit_);
+    return stress_excess(F, std::log(F.determinant()));
+  }
+  Real stress_excess(const Mat<Dim>& F, Real logJ) const {
+    return eigenvalue_excess(undamaged_cauchy(F, logJ), sigma_crit_);
   }
   // The largest eigenvalue of the symmetric part of s.
   static Real max_symmetric_eigenvalue(const Mat<Dim>& s) {
@@ -214,9 +227,14 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
 
   // Damage update at fixed F (lap d, when l0 > 0, from the step); F is not changed.
   void project(Mat<Dim>& F, Real* q, Real dt) const {
+    project_given_log(F, std::log(F.determinant()), q, dt);
+  }
+  // The same with ln J given: the return map takes the logarithms of a batch at
+  // once (ModelBase::return_map).
+  void project_given_log(Mat<Dim>& F, Real logJ, Real* q, Real dt) const {
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
-    const Real d_new = advanced_damage(d_old, stress_excess(F), q, dt);
+    const Real d_new = advanced_damage(d_old, stress_excess(F, logJ), q, dt);
     if (!(d_new > d_old)) return;
     q[kDissipated] += (degradation(d_old) - degradation(d_new)) * split(F).plus;
     q[kDamage] = d_new;
@@ -250,7 +268,10 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   }
   // Kirchhoff stress with the tensile part scaled by g.
   Mat<Dim> tau_with(const Mat<Dim>& F, Real g) const {
-    const Real J = F.determinant(), logJ = std::log(J), s = pow_2_over_dim(J, logJ);
+    return tau_with(F, std::log(F.determinant()), g);
+  }
+  Mat<Dim> tau_with(const Mat<Dim>& F, Real logJ, Real g) const {
+    const Real J = F.determinant(), s = pow_2_over_dim(J, logJ);
     const Mat<Dim> I = Mat<Dim>::Identity();
     const Mat<Dim> tau_dev = c_.mu * (F * F.transpose() - s * I);
     const Mat<Dim> tau_vol = (c_.mu * (s - 1) + c_.lambda * logJ) * I;

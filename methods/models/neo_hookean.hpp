@@ -43,8 +43,12 @@ class NeoHookean final : public ModelBase<Dim, NeoHookean<Dim>> {
     const Real logJ = std::log(F.determinant());
     return c_.mu * (F - F_invT) + c_.lambda * logJ * F_invT;
   }
-  Mat<Dim> tau(const Mat<Dim>& F, const Real*) const {
-    const Real logJ = std::log(F.determinant());
+  Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
+    return tau_given_log(F, std::log(F.determinant()), q);
+  }
+  // tau with ln J given: the stress pass takes the logarithms of a batch at once
+  // (ModelBase::kirchhoff_times_volume).
+  Mat<Dim> tau_given_log(const Mat<Dim>& F, Real logJ, const Real*) const {
     return c_.mu * (F * F.transpose() - Mat<Dim>::Identity()) +
            c_.lambda * logJ * Mat<Dim>::Identity();
   }

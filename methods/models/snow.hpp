@@ -117,9 +117,17 @@ class Snow final : public ModelBase<Dim, Snow<Dim>> {
   // the clamped elastic part on exit. A trial state inside the elastic region
   // is left untouched (bit for bit).
   void project(Mat<Dim>& F, Real* q, Real /*dt*/) const {
-    const SignedSvd<Dim> svd = signed_svd<Dim>(F);
     const Real lo = 1 - theta_c_, hi = 1 + theta_s_;
-    if ((svd.sigma.array() >= lo).all() && (svd.sigma.array() <= hi).all()) return;
+    const auto elastic = [&](const Vec<Dim>& sigma) {
+      return (sigma.array() >= lo).all() && (sigma.array() <= hi).all();
+    };
+    // In 2D the singular values alone decide (most particles stay elastic); in
+    // 3D they come from the full SVD anyway.
+    if constexpr (Dim == 2) {
+      if (elastic(signed_singular_values<Dim>(F))) return;
+    }
+    const SignedSvd<Dim> svd = signed_svd<Dim>(F);
+    if (elastic(svd.sigma)) return;
     const Real psi_trial = psi(F, q);
     const Vec<Dim> clamped = svd.sigma.cwiseMax(lo).cwiseMin(hi);
     F = svd.U * clamped.asDiagonal() * svd.V.transpose();

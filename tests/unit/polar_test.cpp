@@ -7,6 +7,7 @@
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
 #include <Eigen/SVD>
+#include <algorithm>
 #include <cmath>
 #include <numbers>
 #include <random>
@@ -95,6 +96,30 @@ TYPED_TEST(PolarTest, SignedSvdReconstructsWithRotations) {
     if (std::abs(det) > 1e-6) {
       EXPECT_EQ(svd.sigma(Dim - 1) < 0, det < 0) << "det F = " << det;
     }
+  }
+}
+
+// The singular values alone (the return maps' elastic test) are signed_svd's own,
+// bit for bit, and their squares the eigenvalues of F^T F.
+TYPED_TEST(PolarTest, SingularValuesAloneAreTheSvdsBitForBit) {
+  constexpr int Dim = TestFixture::Dim;
+  auto matrices = TestMatrices<Dim>(this->gen_);
+  // Reflection parts of round-off size (1e-17, whose square is below 1e-30: the
+  // state of most particles of a resting snow pile) and near underflow.
+  for (const Real tiny : {Real(1e-17), Real(3e-160)}) {
+    Mat<Dim> F = 2 * Mat<Dim>::Identity();
+    F(0, 1) = tiny;
+    matrices.push_back({"2 I with a tiny shear", F});
+  }
+  for (const auto& [label, F] : matrices) {
+    SCOPED_TRACE(label);
+    const Vec<Dim> sigma = signed_singular_values<Dim>(F);
+    const Vec<Dim> from_svd = signed_svd<Dim>(F).sigma;
+    for (int a = 0; a < Dim; ++a) EXPECT_EQ(sigma(a), from_svd(a));
+    Eigen::SelfAdjointEigenSolver<Mat<Dim>> eig(F.transpose() * F);
+    Vec<Dim> squares = sigma.cwiseAbs2();
+    std::sort(squares.data(), squares.data() + Dim);
+    EXPECT_LT((squares - eig.eigenvalues()).norm(), kTol * (1 + F.squaredNorm()));
   }
 }
 

@@ -1,0 +1,125 @@
+// The stress pass's vectorised logarithm (core/batch_log.hpp) against the C
+// library's long-double logl, and the stresses that use it against V0 P F^T.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+#include <random>
+#include <vector>
+
+#include "core/batch_log.hpp"
+#include "core/parameters.hpp"
+#include "core/particles.hpp"
+#include "models/damage.hpp"
+#include "models/neo_hookean.hpp"
+
+namespace batch_log_test {
+using namespace mpmtb;
+
+// |y - ln x| in units in the last place of ln x, against logl.
+double ulps(Real x, Real y) {
+  const long double exact = logl(static_cast<long double>(x));
+  const Real r = static_cast<Real>(exact);
+  const Real ulp = std::nextafter(std::abs(r), std::numeric_limits<Real>::infinity()) - std::abs(r);
+  return static_cast<double>(std::abs(static_cast<long double>(y) - exact) / ulp);
+}
+
+std::vector<Real> batch(const std::vector<Real>& x) {
+  std::vector<Real> y(x.size());
+  batch_log(x.data(), y.data(), static_cast<int>(x.size()));
+  return y;
+}
+
+TEST(BatchLog, WithinTwoUlpOverTheWholeRangeAndNearOne) {
+  std::vector<Real> x;
+  std::mt19937_64 rng(7);
+  const double lo = std::log(std::numeric_limits<Real>::min()),
+               hi = std::log(std::numeric_limits<Real>::max());
+  std::uniform_real_distribution<double> exponent(lo, hi), near_one(-1e-3, 1e-3);
+  for (int k = 0; k < 20000; ++k) x.push_back(static_cast<Real>(std::exp(exponent(rng))));
+  for (int k = 0; k < 20000; ++k) x.push_back(static_cast<Real>(1 + near_one(rng)));
+  // Around the reduction's switch at sqrt(2), and the neighbours of 1.
+  Real s = Real(1.4142135623730950488), u = 1, d = 1;
+  for (int k = 0; k < 64; ++k) {
+    x.push_back(s), s = std::nextafter(s, Real(2));
+    x.push_back(u = std::nextafter(u, Real(2)));
+    x.push_back(d = std::nextafter(d, Real(0)));
+  }
+  const std::vector<Real> y = batch(x);
+  double worst = 0;
+  for (std::size_t k = 0; k < x.size(); ++k) worst = std::max(worst, ulps(x[k], y[k]));
+  EXPECT_LE(worst, 2.5) << "measured 1.97 ulp in double and float";
+  EXPECT_EQ(batch({Real(1)})[0], Real(0));
+}
+
+TEST(BatchLog, ValuesOutsideThePositiveNormalsGetTheLibraryResult) {
+  const Real inf = std::numeric_limits<Real>::infinity();
+  const std::vector<Real> x = {0,
+                               -Real(0),
+                               -1,
+                               inf,
+                               -inf,
+                               std::numeric_limits<Real>::quiet_NaN(),
+                               std::numeric_limits<Real>::denorm_min(),
+                               Real(2.5)};
+  const std::vector<Real> y = batch(x);
+  for (std::size_t k = 0; k < x.size(); ++k) {
+    const Real expected = std::log(x[k]);
+    if (std::isnan(expected)) {
+      EXPECT_TRUE(std::isnan(y[k])) << x[k];
+    } else {
+      EXPECT_EQ(y[k], expected) << x[k];
+    }
+  }
+}
+
+TEST(BatchLog, EveryLengthGivesTheSameValuesAsOneByOne) {
+  std::vector<Real> x;
+  for (int k = 0; k < 19; ++k) x.push_back(Real(0.37) + Real(0.61) * k);
+  for (int n = 1; n <= 19; ++n) {
+    std::vector<Real> y(n);
+    batch_log(x.data(), y.data(), n);
+    for (int k = 0; k < n; ++k) {
+      Real one;
+      batch_log(&x[k], &one, 1);
+      EXPECT_EQ(y[k], one) << "n = " << n << ", k = " << k;
+    }
+  }
+}
+
+// The batched stress pass (ModelBase::kirchhoff_times_volume) is V0 P F^T of the
+// model's own first Piola stress, for more particles than one batch.
+template <class Model>
+void expect_kirchhoff_is_P_F_transposed(Parameters params) {
+  const Model model(params);
+  Particles<3> P;
+  P.state_size = model.state_size();
+  std::mt19937_64 rng(3);
+  std::uniform_real_distribution<Real> u(-0.2, 0.2);
+  const int n = 150;  // more than two batches of 64
+  std::vector<int> ids;
+  for (int p = 0; p < n; ++p) {
+    P.add(Vec<3>::Zero(), Vec<3>::Zero(), 1, Real(0.5) + Real(p) / n, 0);
+    for (int i = 0; i < 9; ++i) P.F[p](i / 3, i % 3) += u(rng);
+    if (P.state_size) model.initial_state(P.state_of(p));
+    ids.push_back(p);
+  }
+  std::vector<Mat<3>> tauV(n);
+  model.kirchhoff_times_volume(P, ids, tauV);
+  for (int p = 0; p < n; ++p) {
+    const Mat<3> expected = P.V0[p] * model.first_piola(P.F[p], P.state_of(p)) * P.F[p].transpose();
+    EXPECT_LE((tauV[p] - expected).norm(), 1e-12 * expected.norm()) << "particle " << p;
+  }
+}
+
+TEST(BatchLog, NeoHookeanStressPassIsV0PFTransposed) {
+  expect_kirchhoff_is_P_F_transposed<NeoHookean<3>>(
+      Parameters("materials.test", {{"E", 1e4}, {"nu", 0.3}, {"density", 1}}));
+}
+
+TEST(BatchLog, DamageStressPassIsV0PFTransposed) {
+  expect_kirchhoff_is_P_F_transposed<Damage<3>>(
+      Parameters("materials.test", {{"E", 1e4}, {"nu", 0.3}, {"density", 1}, {"sigma_crit", 100}}));
+}
+
+}  // namespace batch_log_test
