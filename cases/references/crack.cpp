@@ -32,8 +32,8 @@ CrackGeometry<Dim>::CrackGeometry(const Scene& scene) {
   // the stretched plate's damage next to the cut reaches.
   h_ = scene.dx();
   const bool cut = (body.cut_max.array() > body.cut_min.array()).head<2>().all();
-  seed_lo_ = (cut ? body.cut_min : center_).head<2>().array() - 2 * h_;
-  seed_hi_ = (cut ? body.cut_max : center_).head<2>().array() + 2 * h_;
+  seed_lo_ = ((cut ? body.cut_min : center_).head<2>().array() - 2 * h_).matrix().cast<double>();
+  seed_hi_ = ((cut ? body.cut_max : center_).head<2>().array() + 2 * h_).matrix().cast<double>();
 }
 
 // Keeps in `in` only the particles in cells of size h_ (x-y) joined, through
