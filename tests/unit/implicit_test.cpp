@@ -21,6 +21,7 @@
 #include "models/registry.hpp"
 #include "references/reference.hpp"
 #include "setup.hpp"
+#include "support/pinned.hpp"
 #include "support/random_matrices.hpp"
 #include "support/scenes.hpp"
 
@@ -243,10 +244,7 @@ TEST(ImplicitPins, PinnedNodesHoldAtLargeSteps) {
     stepper->set_integrator(integrator);
     const Real c = s.max_wave_speed(), dt = 0.01;
     EXPECT_GT(dt * c / s.grid.geo.dx, 5);  // far beyond the explicit limit
-    std::vector<Vec<2>> x0;
-    for (std::size_t p = 0; p < s.particles.size(); ++p) {
-      if (s.particles.pinned[p]) x0.push_back(s.particles.x[p]);
-    }
+    const std::vector<Vec<2>> x0 = testing::pinned_positions(s.particles);
     ASSERT_FALSE(x0.empty());
     const Diagnostics d0 = measure(s, *stepper);
     for (int n = 0; n < 50; ++n) {
@@ -254,12 +252,8 @@ TEST(ImplicitPins, PinnedNodesHoldAtLargeSteps) {
       ASSERT_LT(r.non_finite, 0);
       ASSERT_TRUE(stepper->implicit_stats()->converged) << "step " << n;
     }
-    std::size_t k = 0;
-    Real moved = 0;
-    for (std::size_t p = 0; p < s.particles.size(); ++p) {
-      if (s.particles.pinned[p]) moved = std::max(moved, (s.particles.x[p] - x0[k++]).norm());
-    }
-    EXPECT_EQ(moved, 0) << integrator_name(integrator);
+    EXPECT_EQ(testing::largest_pinned_displacement(s.particles, x0), 0)
+        << integrator_name(integrator);
     const Diagnostics d = measure(s, *stepper);
     const Vec3 expected = d0.momentum + d0.mass * s.time * Vec3(0, -9.81, 0) + s.pin_impulse;
     const Real scale = d0.mass * 9.81 * s.time;

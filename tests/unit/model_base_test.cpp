@@ -1,0 +1,99 @@
+// ModelBase's own paths for a model that writes out less than the built-in ones:
+// a St. Venant-Kirchhoff model with psi, P and tau but no dP gets the central
+// difference of P as its first_piola_differential (the implicit integrators'
+// Hessian), which must match the exact differential of P, and its stresses
+// through the batch loop (no tau_given_log) must be V0 P F^T.
+#include <gtest/gtest.h>
+
+#include <random>
+#include <span>
+#include <vector>
+
+#include "core/particles.hpp"
+#include "models/model.hpp"
+#include "support/random_matrices.hpp"
+
+namespace mpmtb {
+namespace model_base_test {
+
+// St. Venant-Kirchhoff (Bonet & Wood 2008, sec. 6.4.1): E = (F^T F - I)/2,
+//   S = lambda tr(E) I + 2 mu E,  P = F S,  psi = lambda/2 tr(E)^2 + mu E : E.
+template <int Dim>
+class StVenantKirchhoff final : public ModelBase<Dim, StVenantKirchhoff<Dim>> {
+ public:
+  static constexpr Real mu = 3, lambda = 5;
+  std::string_view name() const override { return "st-venant-kirchhoff (test)"; }
+  Real density() const override { return 1; }
+  Real wave_speed() const override { return std::sqrt(lambda + 2 * mu); }
+
+  static Mat<Dim> green(const Mat<Dim>& F) {
+    return Real(0.5) * (F.transpose() * F - Mat<Dim>::Identity());
+  }
+  Real psi(const Mat<Dim>& F, const Real*) const {
+    const Mat<Dim> E = green(F);
+    return Real(0.5) * lambda * E.trace() * E.trace() + mu * E.cwiseProduct(E).sum();
+  }
+  Mat<Dim> P(const Mat<Dim>& F, const Real*) const {
+    const Mat<Dim> E = green(F);
+    return F * (lambda * E.trace() * Mat<Dim>::Identity() + 2 * mu * E);
+  }
+  Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const { return P(F, q) * F.transpose(); }
+  // No dP: ModelBase differentiates P numerically.
+};
+
+// The exact differential: dP = dF S + F dS, dS = lambda tr(dE) I + 2 mu dE,
+// dE = (dF^T F + F^T dF) / 2.
+template <int Dim>
+Mat<Dim> exact_dP(const Mat<Dim>& F, const Mat<Dim>& dF) {
+  using Model = StVenantKirchhoff<Dim>;
+  const Mat<Dim> E = Model::green(F), I = Mat<Dim>::Identity();
+  const Mat<Dim> dE = Real(0.5) * (dF.transpose() * F + F.transpose() * dF);
+  const Mat<Dim> S = Model::lambda * E.trace() * I + 2 * Model::mu * E;
+  const Mat<Dim> dS = Model::lambda * dE.trace() * I + 2 * Model::mu * dE;
+  return dF * S + F * dS;
+}
+
+template <int Dim>
+void expect_fallback_matches_exact_differential() {
+  const StVenantKirchhoff<Dim> model;
+  std::mt19937 gen(11 + Dim);
+  for (int trial = 0; trial < 50; ++trial) {
+    const Mat<Dim> F = Mat<Dim>::Identity() + Real(0.4) * testing::RandomMatrix<Dim>(gen);
+    const Mat<Dim> dF = testing::RandomMatrix<Dim>(gen);
+    const Mat<Dim> exact = exact_dP<Dim>(F, dF);
+    const Mat<Dim> fallback = model.first_piola_differential(F, dF, nullptr);
+    // A central difference with h = 1e-6 relative: O(h^2) truncation and
+    // round-off of eps / h, about 1e-10 of |dP|.
+    EXPECT_LE((fallback - exact).norm(), 1e-8 * exact.norm()) << "trial " << trial;
+  }
+  EXPECT_EQ(model.first_piola_differential(Mat<Dim>::Identity(), Mat<Dim>::Zero(), nullptr),
+            Mat<Dim>::Zero());
+}
+
+TEST(ModelBase, FiniteDifferenceDifferentialOfAModelWithoutDP2D) {
+  expect_fallback_matches_exact_differential<2>();
+}
+TEST(ModelBase, FiniteDifferenceDifferentialOfAModelWithoutDP3D) {
+  expect_fallback_matches_exact_differential<3>();
+}
+
+TEST(ModelBase, StressBatchOfAModelWithoutLogIsV0PFTransposed) {
+  const StVenantKirchhoff<3> model;
+  std::mt19937 gen(5);
+  Particles<3> P;
+  std::vector<int> ids;
+  for (int p = 0; p < 100; ++p) {
+    P.add(Vec<3>::Zero(), Vec<3>::Zero(), 1, Real(1) + p, 0);
+    P.F[p] += Real(0.3) * testing::RandomMatrix<3>(gen);
+    ids.push_back(p);
+  }
+  std::vector<Mat<3>> tauV(P.size());
+  model.kirchhoff_times_volume(P, ids, tauV);
+  for (int p = 0; p < 100; ++p) {
+    const Mat<3> expected = P.V0[p] * model.first_piola(P.F[p], nullptr) * P.F[p].transpose();
+    EXPECT_LE((tauV[p] - expected).norm(), 1e-13 * expected.norm()) << "particle " << p;
+  }
+}
+
+}  // namespace model_base_test
+}  // namespace mpmtb
