@@ -118,24 +118,13 @@ class ModelBase : public ConstitutiveModel<Dim> {
   }
   void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
                               std::vector<Mat<Dim>>& tauV) const override {
-    const long n = static_cast<long>(ids.size());
     if constexpr (requires(const Mat<Dim>& F, const Real* q) { self().tau_given_log(F, 0, q); }) {
-      // A model whose tau needs ln J: the logarithms of a batch of particles in
-      // vector registers (core/batch_log.hpp), then the stresses.
-      const long batches = (n + kLogBatch - 1) / kLogBatch;
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-      for (long b = 0; b < batches; ++b) {
-        const long first = b * kLogBatch;
-        const int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
-        Real logJ[kLogBatch];
-        log_det_batch(particles, ids.subspan(first, count), logJ);
-        for (int k = 0; k < count; ++k) {
-          const int p = ids[first + k];
-          tauV[p] = particles.V0[p] *
-                    self().tau_given_log(particles.F[p], logJ[k], particles.state_of(p));
-        }
-      }
+      for_each_with_log(particles, ids, [&](int p, Real logJ) {
+        tauV[p] =
+            particles.V0[p] * self().tau_given_log(particles.F[p], logJ, particles.state_of(p));
+      });
     } else {
+      const long n = static_cast<long>(ids.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
       for (long i = 0; i < n; ++i) {
         const int p = ids[i];
@@ -145,21 +134,9 @@ class ModelBase : public ConstitutiveModel<Dim> {
   }
   void return_map(Particles<Dim>& particles, std::span<const int> ids, Real dt) const override {
     if constexpr (requires(Mat<Dim> & F, Real * q) { self().project_given_log(F, 0, q, dt); }) {
-      // A return map that needs ln J: the logarithms of a batch first, as in
-      // kirchhoff_times_volume.
-      const long n = static_cast<long>(ids.size());
-      const long batches = (n + kLogBatch - 1) / kLogBatch;
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-      for (long b = 0; b < batches; ++b) {
-        const long first = b * kLogBatch;
-        const int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
-        Real logJ[kLogBatch];
-        log_det_batch(particles, ids.subspan(first, count), logJ);
-        for (int k = 0; k < count; ++k) {
-          const int p = ids[first + k];
-          self().project_given_log(particles.F[p], logJ[k], particles.state_of(p), dt);
-        }
-      }
+      for_each_with_log(particles, ids, [&](int p, Real logJ) {
+        self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
+      });
     } else if constexpr (requires(Mat<Dim> & F, Real * q) { self().project(F, q, dt); }) {
       const long n = static_cast<long>(ids.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
@@ -186,12 +163,23 @@ class ModelBase : public ConstitutiveModel<Dim> {
  private:
   // Particles per batch of logarithms (core/batch_log.hpp).
   static constexpr int kLogBatch = 64;
-  // logJ[k] = ln det F of particle ids[k], for at most kLogBatch ids.
-  static void log_det_batch(const Particles<Dim>& particles, std::span<const int> ids, Real* logJ) {
-    Real J[kLogBatch];
-    const int count = static_cast<int>(ids.size());
-    for (int k = 0; k < count; ++k) J[k] = particles.F[ids[k]].determinant();
-    batch_log(J, logJ, count);
+  // f(p, ln det F_p) for every particle p of ids, in parallel over batches of
+  // kLogBatch: each batch's logarithms first, in vector registers
+  // (core/batch_log.hpp), then f for its particles. For the models whose stress
+  // or return map needs ln J (tau_given_log, project_given_log).
+  template <class F>
+  static void for_each_with_log(const Particles<Dim>& particles, std::span<const int> ids, F&& f) {
+    const long n = static_cast<long>(ids.size());
+    const long batches = (n + kLogBatch - 1) / kLogBatch;
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long b = 0; b < batches; ++b) {
+      const long first = b * kLogBatch;
+      const int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
+      Real J[kLogBatch], logJ[kLogBatch];
+      for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
+      batch_log(J, logJ, count);
+      for (int k = 0; k < count; ++k) f(ids[first + k], logJ[k]);
+    }
   }
   const Derived& self() const {
     return static_cast<const Derived&>(*this);
