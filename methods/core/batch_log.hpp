@@ -1,6 +1,6 @@
-// ln x for a batch of values, in plain arithmetic that the compiler vectorises
-// across the batch: std::log is one library call per value, which the stress
-// pass of the logarithmic models (neo-Hookean) spent a third of its time in.
+// ln x for a batch of values, a vector register of lanes at a time: std::log is
+// one library call per value, which the stress pass of the logarithmic models
+// (neo-Hookean) spent a third of its time in.
 #pragma once
 
 #include <algorithm>

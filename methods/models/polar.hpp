@@ -78,6 +78,19 @@ inline void unit2(Real x, Real y, Real n, Real& c, Real& s) {
     c = 1, s = 0;
   }
 }
+// The rotation part (E, H) and the reflection part (D, G) of a 2x2 F, and
+// their lengths q and r (the header's 2x2 closed form): the singular values are
+// q + r and q - r.
+struct Parts2 {
+  Real E, H, D, G, q, r;
+};
+inline Parts2 parts2(const Mat<2>& F) {
+  Parts2 t;
+  t.E = Real(0.5) * (F(0, 0) + F(1, 1)), t.H = Real(0.5) * (F(1, 0) - F(0, 1));
+  t.D = Real(0.5) * (F(0, 0) - F(1, 1)), t.G = Real(0.5) * (F(1, 0) + F(0, 1));
+  t.q = norm2(t.E, t.H), t.r = norm2(t.D, t.G);
+  return t;
+}
 }  // namespace detail
 
 template <int Dim>
@@ -88,9 +101,7 @@ SignedSvd<Dim> signed_svd(const Mat<Dim>& F) {
     out.U = out.V = Mat<1>::Identity();
     out.sigma(0) = F(0, 0);
   } else if constexpr (Dim == 2) {
-    const Real E = Real(0.5) * (F(0, 0) + F(1, 1)), H = Real(0.5) * (F(1, 0) - F(0, 1));
-    const Real D = Real(0.5) * (F(0, 0) - F(1, 1)), G = Real(0.5) * (F(1, 0) + F(0, 1));
-    const Real q = detail::norm2(E, H), r = detail::norm2(D, G);
+    const auto [E, H, D, G, q, r] = detail::parts2(F);
     Real c1, s1, c2, s2;  // angles a1 of (D, G) and a2 of (E, H)
     detail::unit2(D, G, r, c1, s1);
     detail::unit2(E, H, q, c2, s2);
@@ -140,10 +151,8 @@ SignedSvd<Dim> signed_svd(const Mat<Dim>& F) {
 template <int Dim>
 Vec<Dim> signed_singular_values(const Mat<Dim>& F) {
   if constexpr (Dim == 2) {
-    const Real E = Real(0.5) * (F(0, 0) + F(1, 1)), H = Real(0.5) * (F(1, 0) - F(0, 1));
-    const Real D = Real(0.5) * (F(0, 0) - F(1, 1)), G = Real(0.5) * (F(1, 0) + F(0, 1));
-    const Real q = detail::norm2(E, H), r = detail::norm2(D, G);
-    return Vec<2>(q + r, q - r);
+    const detail::Parts2 t = detail::parts2(F);
+    return Vec<2>(t.q + t.r, t.q - t.r);
   } else {
     return signed_svd<Dim>(F).sigma;
   }

@@ -122,12 +122,12 @@ class Snow final : public ModelBase<Dim, Snow<Dim>> {
       return (sigma.array() >= lo).all() && (sigma.array() <= hi).all();
     };
     // In 2D the singular values alone decide (most particles stay elastic); in
-    // 3D they come from the full SVD anyway.
+    // 1D and 3D they come from the full SVD anyway.
     if constexpr (Dim == 2) {
       if (elastic(signed_singular_values<Dim>(F))) return;
     }
     const SignedSvd<Dim> svd = signed_svd<Dim>(F);
-    if (elastic(svd.sigma)) return;
+    if (Dim != 2 && elastic(svd.sigma)) return;
     const Real psi_trial = psi(F, q);
     const Vec<Dim> clamped = svd.sigma.cwiseMax(lo).cwiseMin(hi);
     F = svd.U * clamped.asDiagonal() * svd.V.transpose();

@@ -77,7 +77,7 @@ TEST(ModelBase, FiniteDifferenceDifferentialOfAModelWithoutDP3D) {
   expect_fallback_matches_exact_differential<3>();
 }
 
-TEST(ModelBase, StressBatchOfAModelWithoutLogIsV0PFTransposed) {
+TEST(ModelBase, StressPassOfAModelWithoutLogIsV0PFTransposed) {
   const StVenantKirchhoff<3> model;
   std::mt19937 gen(5);
   Particles<3> P;
