@@ -148,22 +148,23 @@ class NonlocalLaplacian {
   void transfer_to_grid(const State<Dim>& s) {
     const auto& P = s.particles;
     const auto& geo = s.grid.geo;
+    Real* const m = m_.data();
+    Real* const q = q_.data();
     blocks_.for_each_coloured(s, [&](int p) {
       if (!requested(P, p)) return;
       const LaplacianRequest& r = requests_[P.material[p]];
       const Real mp = P.m[p], mq = mp * P.state_of(p)[r.source];
       const StencilT st(P.x[p], P.F[p], geo);
-      const auto add_mq = [&](long node, Real w) {
-        m_[node] += w * mp;
-        q_[node] += w * mq;
+      const auto add_mq = [&](long node, Real w) MPMTB_INLINE_LAMBDA {
+        m[node] += w * mp;
+        q[node] += w * mq;
       };
       if (!aniso_) {  // the isotropic path, as it always was
-        st.for_each_node(
-            geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) { add_mq(node, w); });
+        st.for_each_weight(geo, add_mq);
         return;
       }
       const Mat<Dim> mA = mp * structural_tensor(r, P.state_of(p));
-      st.for_each_node(geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+      st.for_each_weight(geo, [&](long node, Real w) {
         add_mq(node, w);
         for (int a = 0; a < Dim; ++a) {
           for (int b = a; b < Dim; ++b) A_[comp(a, b)][node] += w * mA(a, b);
@@ -250,16 +251,22 @@ class NonlocalLaplacian {
     auto& P = s.particles;
     const auto& geo = s.grid.geo;
     const Real diagonal = 2 * Dim / (geo.dx * geo.dx);
+    const Real* const lap_data = lap_.data();
     const long n = static_cast<long>(P.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       if (!requested(P, p)) continue;
       Real lap = 0, diag = 0;
-      StencilT(P.x[p], P.F[p], geo)
-          .for_each_node(geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
-            lap += w * lap_[node];
-            if (aniso_) diag += w * diag_[node];
-          });
+      const StencilT st(P.x[p], P.F[p], geo);
+      if (aniso_) {
+        st.for_each_weight(geo, [&](long node, Real w) {
+          lap += w * lap_[node];
+          diag += w * diag_[node];
+        });
+      } else {
+        st.for_each_weight(
+            geo, [&](long node, Real w) MPMTB_INLINE_LAMBDA { lap += w * lap_data[node]; });
+      }
       Real* q = P.state_of(p);
       const int target = requests_[P.material[p]].target;
       q[target] = lap;

@@ -4,6 +4,9 @@
 #pragma once
 
 #include <cmath>
+#if defined(__AVX__)
+#include <immintrin.h>
+#endif
 
 #include "grid.hpp"
 #include "pack.hpp"
@@ -61,6 +64,23 @@ constexpr bool kernel_particle_inertia = [] {
 
 // One SIMD value with a lane per axis (up to 3 axes and a padding lane).
 typedef Real AxisPack __attribute__((vector_size(4 * sizeof(Real))));
+
+// The lanes' square roots: one vector instruction where the target has it
+// (correctly rounded, as std::sqrt; the lanes are never negative where used).
+// (A template, so that only the branch of the build's Real is compiled.)
+template <class Pack = AxisPack>
+inline Pack axis_sqrt(Pack x) {
+#if defined(__AVX__)
+  if constexpr (sizeof(Pack) == 32) {
+    return reinterpret_cast<Pack>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(x)));
+  } else {
+    return reinterpret_cast<Pack>(_mm_sqrt_ps(reinterpret_cast<__m128>(x)));
+  }
+#else
+  for (int a = 0; a < 4; ++a) x[a] = std::sqrt(x[a]);
+  return x;
+#endif
+}
 
 // Kernels whose branch-free weights() takes any value type: the stencil then
 // evaluates every axis at once, one axis per lane of an AxisPack.
@@ -178,6 +198,15 @@ struct Stencil {
     loop_axis<0>(g.strides(), base_node, Real(1), grad_part, dpos, f);
   }
 
+  // Calls f(node, w_ip) for every node of the stencil, last axis fastest: the
+  // weights alone, with the same products as for_each_node (the same bits), in
+  // a loop that keeps no gradient or offset (perf: for_each_node's callers that
+  // read only w spilled those to the stack, 2x the cost of the loop itself).
+  template <class Fn>
+  MPMTB_INLINE void for_each_weight(const GridGeometry<Dim>& g, Fn&& f) const {
+    weight_axis<0>(g.strides(), base_node, Real(1), f);
+  }
+
   // D_p = sum_i w_ip (x_i - x_p)(x_i - x_p)^T. Diagonal for tensor-product kernels
   // (the off-diagonal sums factor into zero first moments).
   Vec<Dim> inertia_diagonal() const {
@@ -196,6 +225,19 @@ struct Stencil {
     wk[k][a] = w_ak;
     dwk[k][a] = dw_ak;
     dk[k][a] = d_ak;
+  }
+  // Axis A of for_each_weight's loop; `weight` = prod_{b<A} w_b on entry.
+  template <int A, class Fn>
+  MPMTB_INLINE void weight_axis(const std::array<long, Dim>& stride, long node, Real weight,
+                                Fn& f) const {
+    for (int k = 0; k < S; ++k) {
+      const long n = node + k * (A == Dim - 1 ? 1 : stride[A]);
+      if constexpr (A == Dim - 1) {
+        f(n, weight * w(A, k));
+      } else {
+        weight_axis<A + 1>(stride, n, weight * w(A, k), f);
+      }
+    }
   }
   // Axis A of the tensor-product loop. On entry `weight` is prod_{b<A} w_b and
   // grad_part[a] = dw_a prod_{b<A, b!=a} w_b for a < A.

@@ -182,6 +182,12 @@ struct Stencil<Dim, CpdiKernel> {
     }
   }
 
+  // Calls f(node, w_ip) for every node of the box (Stencil::for_each_weight).
+  template <class Fn>
+  void for_each_weight(const GridGeometry<Dim>& g, Fn&& f) const {
+    for_each_node(g, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) { f(node, w); });
+  }
+
   // D_p = sum_i w_ip (x_i - x_p)(x_i - x_p)^T, full.
   Mat<Dim> inertia() const {
     Mat<Dim> D = Mat<Dim>::Zero();

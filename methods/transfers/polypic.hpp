@@ -38,18 +38,26 @@ namespace mpmtb {
 // kernel weights: sum_k w_a(k) e_n(u_k) e_m(u_k) = 0 for n != m, with
 // u_k = (x_i - x_p)_a / dx the node offsets in cell units. The tensor products
 // s_r(i) = prod_a e_{r_a}(u_{i_a}) are then orthogonal under w_ip = prod_a w_a,
-// and their norms factor: sum_i w_ip s_r(i)^2 = prod_a norm[a][r_a].
+// and their norms factor: sum_i w_ip s_r(i)^2 = prod_a norm(a, r_a).
 template <int Dim, int S>
 struct PolyModes {
   static constexpr int count = ipow(S, Dim);  // modes = stencil nodes
 
-  Real e[Dim][S][S];      // e[a][n][k]: e_n at node k of axis a
-  Real norm[Dim][S];      // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
-  Real unit[Dim][S][S];   // e_n / sqrt(norm) for n >= 1 (0 if dropped), e_0 = 1 (norm 1)
-  Real wunit[Dim][S][S];  // w_a(k) unit[a][n][k]: the weight folded in (the transforms)
-  Real root_norm[Dim];    // sqrt(norm[a][1]): e_1 = root_norm unit_1
-  Real d0[Dim];           // offset of node 0 per axis
+  // Per mode n and node k, one AxisPack with axis a in lane a, as the stencil's
+  // factors (the build runs all axes at once and stores whole registers):
+  AxisPack e_[S][S];      // e_n at node k
+  AxisPack norm_[S];      // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
+  AxisPack unit_[S][S];   // e_n / sqrt(norm) for n >= 1 (0 if dropped), e_0 = 1 (norm 1)
+  AxisPack wunit_[S][S];  // w_a(k) unit_n(k): the weight folded in (the transforms)
+  AxisPack root_norm_;    // sqrt(norm_1): e_1 = root_norm unit_1
+  AxisPack d0_;           // offset of node 0 per axis
   Real inv_dx;
+
+  Real e(int a, int n, int k) const { return e_[n][k][a]; }
+  Real norm(int a, int n) const { return norm_[n][a]; }
+  Real unit(int a, int n, int k) const { return unit_[n][k][a]; }
+  Real wunit(int a, int n, int k) const { return wunit_[n][k][a]; }
+  Real root_norm(int a) const { return root_norm_[a]; }
 
   // Gram-Schmidt of the monomials 1, u, u^2, ... under the weights, twice over
   // ("twice is enough"): orthogonal to round-off relative to each e_n's own size,
@@ -67,16 +75,21 @@ struct PolyModes {
     using Lanes = AxisPack;
     inv_dx = 1 / dx;
     const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
-    Lanes u[S], power[S], q[S][S], norm_n[S], inv_norm[S];
+    Lanes u[S], power[S], q[S][S], inv_norm[S];
     const Lanes(&w)[S] = st.wk;
     for (int k = 0; k < S; ++k) {
       u[k] = st.dk[k] * inv_dx;
       power[k] = 1 - Lanes{};
     }
     auto dropped = zero < zero;  // all lanes false
+    // Unrolled whole (perf: as loops, the triangular m < n branched and kept the
+    // values in memory), so that every index is a constant.
+#pragma GCC unroll 8
     for (int n = 0; n < S; ++n) {
       for (int k = 0; k < S; ++k) q[n][k] = power[k];
+#pragma GCC unroll 2
       for (int pass = 0; pass < 2; ++pass) {
+#pragma GCC unroll 8
         for (int m = 0; m < n; ++m) {
           Lanes dot{};
           for (int k = 0; k < S; ++k) dot += w[k] * q[n][k] * q[m][k];
@@ -91,23 +104,20 @@ struct PolyModes {
         power[k] *= u[k];
       }
       dropped = dropped | ~(nn > tol * monomial);  // lane masks: NaN is dropped too
-      norm_n[n] = dropped ? zero : nn;
+      norm_[n] = dropped ? zero : nn;
       inv_norm[n] = dropped ? zero : 1 / nn;
     }
-    for (int a = 0; a < Dim; ++a) {
-      for (int n = 0; n < S; ++n) {
-        norm[a][n] = norm_n[n][a];
-        // The partition of unity makes e_0 = 1 a unit mode (sum_k w_a(k) = 1).
-        const Real inv_root = n == 0 ? Real(1) : std::sqrt(inv_norm[n][a]);
-        for (int k = 0; k < S; ++k) {
-          e[a][n][k] = q[n][k][a];
-          unit[a][n][k] = q[n][k][a] * inv_root;
-          wunit[a][n][k] = st.w(a, k) * unit[a][n][k];
-        }
-        if (n == 1) root_norm[a] = norm_n[1][a] * inv_root;  // sqrt(norm), 0 if dropped
+    for (int n = 0; n < S; ++n) {
+      // The partition of unity makes e_0 = 1 a unit mode (sum_k w_a(k) = 1).
+      const Lanes inv_root = n == 0 ? 1 - zero : axis_sqrt(inv_norm[n]);
+      for (int k = 0; k < S; ++k) {
+        e_[n][k] = q[n][k];
+        unit_[n][k] = q[n][k] * inv_root;
+        wunit_[n][k] = w[k] * unit_[n][k];
       }
-      d0[a] = st.d(a, 0);
+      if (n == 1) root_norm_ = norm_[1] * inv_root;  // sqrt(norm), 0 if dropped
     }
+    d0_ = st.dk[0];
   }
 
   // The stencil index (last axis fastest, as Stencil::for_each_node) of the node
@@ -115,25 +125,25 @@ struct PolyModes {
   int node_index(const Vec<Dim>& d) const {
     int index = 0;
     for (int a = 0; a < Dim; ++a) {
-      index = index * S + static_cast<int>(std::lround((d[a] - d0[a]) * inv_dx));
+      index = index * S + static_cast<int>(std::lround((d[a] - d0_[a]) * inv_dx));
     }
     return index;
   }
-  // The unit mode r at the stencil's node j, prod_a unit[a][r_a][j_a] (the
+  // The unit mode r at the stencil's node j, prod_a unit(a, r_a, j_a) (the
   // reference evaluation, one product per mode and node).
   Real unit_mode(int r, int j) const {
     Real s = 1;
-    for (int a = Dim - 1; a >= 0; --a, r /= S, j /= S) s *= unit[a][r % S][j % S];
+    for (int a = Dim - 1; a >= 0; --a, r /= S, j /= S) s *= unit(a, r % S, j % S);
     return s;
   }
 
   // The weighted transforms, on one SIMD Row per node or mode (core/pack.hpp):
-  //   to_nodes: out[i] = sum_r c[r] prod_a wunit[a][r_a][i_a] = w_ip sum_r c_r s_r(i)/|s_r|,
+  //   to_nodes: out[i] = sum_r c[r] prod_a wunit(a, r_a, i_a) = w_ip sum_r c_r s_r(i)/|s_r|,
   //             the field with unit-mode coefficients c at the nodes, times w_ip;
-  //   to_modes: out[r] = sum_i prod_a wunit[a][r_a][i_a] v[i] = sum_i w_ip s_r(i) v_i / |s_r|,
+  //   to_modes: out[r] = sum_i prod_a wunit(a, r_a, i_a) v[i] = sum_i w_ip s_r(i) v_i / |s_r|,
   //             the projection onto the unit modes.
   // Sum-factorised: Dim passes of S x S, each y[j] = sum_k W_a[j_a][k] x[j with j_a -> k]
-  // with W_a = wunit[a] or its transpose. The index arithmetic is constant once unrolled.
+  // with W_a = wunit(a, ., .) or its transpose. The index arithmetic is constant once unrolled.
   template <class Node>
   MPMTB_INLINE void to_nodes(const Node* c, Node* out) const {
     transform<true>(c, out);
@@ -145,7 +155,9 @@ struct PolyModes {
 
   // Mode r = (r_0, ..., r_{Dim-1}) as a flat index: 0 is the constant, linear(a)
   // the mode e_1 along axis a; the rest are the higher modes.
-  static constexpr int linear(int a) { return ipow(S, Dim - 1 - a); }
+  static constexpr int linear(int a) {
+    return ipow(S, Dim - 1 - a);
+  }
   static constexpr bool higher(int r) {
     if (r == 0) return false;
     for (int a = 0; a < Dim; ++a)
@@ -181,7 +193,7 @@ struct PolyModes {
   }
   template <bool Transpose, int A>
   MPMTB_INLINE Real coefficient(int n, int k) const {
-    return Transpose ? wunit[A][k][n] : wunit[A][n][k];
+    return Transpose ? wunit_[k][n][A] : wunit_[n][k][A];
   }
 };
 
@@ -228,6 +240,7 @@ class PolypicPolicy {
       return r.row();
     };
     const Real* stored = P.transfer_state_of(p);
+#pragma GCC unroll 64
     for (int r = 0; r < kModes; ++r) {
       if (Modes::higher(r)) {
         s.c[r] = row(Eigen::Map<const V>(stored));
@@ -238,7 +251,7 @@ class PolypicPolicy {
     // Linear modes in cell units: e_1 = (x_i - x_p)_a / dx, so c = C_p e_a dx,
     // times |e_1| for the unit mode. The higher modes are stored for theirs.
     for (int a = 0; a < Dim; ++a)
-      s.c[Modes::linear(a)] = row(P.C[p].col(a) * (dx_ * s.modes.root_norm[a]));
+      s.c[Modes::linear(a)] = row(P.C[p].col(a) * (dx_ * s.modes.root_norm(a)));
     s.modes.to_nodes(s.c, s.nodes);
     return s;
   }
@@ -324,7 +337,7 @@ class PolypicPolicy {
     // The constant mode is sum_i w_ip v_i (sum_i w_ip = 1): PIC's velocity.
     P.v[p] = g.v;
     for (int a = 0; a < Dim; ++a) {
-      const Real root = g.modes.root_norm[a];
+      const Real root = g.modes.root_norm(a);
       P.C[p].col(a) = root > 0 ? V(c[Modes::linear(a)] / (root * dx_)) : V::Zero();
     }
     deformation_update<Dim>(P.F[p], g.grad_v, dt);

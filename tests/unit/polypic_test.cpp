@@ -29,17 +29,17 @@ void check_modes(Real x, Real dx) {
   modes.build(st, dx);
   constexpr int S = Kernel::support;
   for (int k = 0; k < S; ++k) {
-    EXPECT_EQ(modes.e[0][0][k], 1);
-    EXPECT_NEAR(modes.e[0][1][k], st.d(0, k) / dx, 1e-14);
+    EXPECT_EQ(modes.e(0, 0, k), 1);
+    EXPECT_NEAR(modes.e(0, 1, k), st.d(0, k) / dx, 1e-14);
   }
   for (int n = 0; n < S; ++n) {
-    if (modes.norm[0][n] == 0) continue;
+    if (modes.norm(0, n) == 0) continue;
     Real nn = 0;
-    for (int k = 0; k < S; ++k) nn += st.w(0, k) * modes.e[0][n][k] * modes.e[0][n][k];
-    EXPECT_NEAR(modes.norm[0][n], nn, 1e-14);
+    for (int k = 0; k < S; ++k) nn += st.w(0, k) * modes.e(0, n, k) * modes.e(0, n, k);
+    EXPECT_NEAR(modes.norm(0, n), nn, 1e-14);
     for (int m = 0; m < n; ++m) {
       Real dot = 0;
-      for (int k = 0; k < S; ++k) dot += st.w(0, k) * modes.e[0][n][k] * modes.e[0][m][k];
+      for (int k = 0; k < S; ++k) dot += st.w(0, k) * modes.e(0, n, k) * modes.e(0, m, k);
       EXPECT_LE(std::abs(dot), 1e-15) << Kernel::name << " modes " << n << ", " << m;
     }
   }
@@ -61,13 +61,13 @@ TEST(PolypicModes, DegenerateModesAreDropped) {
   const Stencil<1, LinearKernel> hat(Vec<1>(0.75), geo);
   PolyModes<1, 2> m2;
   m2.build(hat, 0.25);
-  EXPECT_GT(m2.norm[0][0], 0);
-  EXPECT_EQ(m2.norm[0][1], 0);
+  EXPECT_GT(m2.norm(0, 0), 0);
+  EXPECT_EQ(m2.norm(0, 1), 0);
   const Stencil<1, QuadraticKernel> quad(Vec<1>(0.625), geo);
   PolyModes<1, 3> m3;
   m3.build(quad, 0.25);
-  EXPECT_GT(m3.norm[0][1], 0);
-  EXPECT_EQ(m3.norm[0][2], 0);
+  EXPECT_GT(m3.norm(0, 1), 0);
+  EXPECT_EQ(m3.norm(0, 2), 0);
 }
 
 // A velocity field of degree <= support - 1 along every axis (here: affine,
