@@ -77,7 +77,9 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   std::string_view kernel_name() const override { return Kernel::name; }
   bool gradient_based() const override { return transfer_is_gradient_based<Transfer>(); }
 
-  void prepare(const State<Dim>& s) override {
+  void prepare(State<Dim>& s) override {
+    s.particles.use_transfer_state(kTransferState);
+    tauV_.assign(s.particles.size(), Mat<Dim>::Zero());  // written: the pages touched now
     sums_.resize(s.grid.size());
     if constexpr (kTensorPath) rows_.resize(s.grid.size());
     v_rows_.resize(s.grid.size());
