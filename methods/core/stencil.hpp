@@ -200,8 +200,8 @@ struct Stencil {
 
   // Calls f(node, w_ip) for every node of the stencil, last axis fastest: the
   // weights alone, with the same products as for_each_node (the same bits), in
-  // a loop that keeps no gradient or offset (perf: for_each_node's callers that
-  // read only w spilled those to the stack, 2x the cost of the loop itself).
+  // a loop that keeps no gradient or offset (perf: the nonlocal transfer's
+  // for_each_node, which read only w, still stored them on the stack).
   template <class Fn>
   MPMTB_INLINE void for_each_weight(const GridGeometry<Dim>& g, Fn&& f) const {
     weight_axis<0>(g.strides(), base_node, Real(1), f);
