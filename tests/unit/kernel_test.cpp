@@ -9,6 +9,7 @@
 #include <random>
 #include <set>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/grid.hpp"
@@ -133,6 +134,34 @@ TYPED_TEST(KernelTest, ReproducesConstantAndLinearFields) {
   CheckReproduction<1, TypeParam>();
   CheckReproduction<2, TypeParam>();
   CheckReproduction<3, TypeParam>();
+}
+
+// Stencil::for_each_weight (the weights-only loop of the nonlocal transfers)
+// visits the nodes of for_each_node in the same order with the same weights,
+// bit for bit: the products are formed in the same order.
+template <int Dim, class K>
+void CheckWeightsAlone() {
+  SCOPED_TRACE(::testing::Message() << K::name << ", Dim = " << Dim);
+  const auto g = TestGrid<Dim>();
+  for (const auto& xp : Samples(g)) {
+    const Stencil<Dim, K> st(xp, g);
+    std::vector<std::pair<long, Real>> full, alone;
+    st.for_each_node(g, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+      full.emplace_back(node, w);
+    });
+    st.for_each_weight(g, [&](long node, Real w) { alone.emplace_back(node, w); });
+    ASSERT_EQ(alone.size(), full.size());
+    for (std::size_t i = 0; i < full.size(); ++i) {
+      EXPECT_EQ(alone[i].first, full[i].first) << "node " << i;
+      EXPECT_EQ(alone[i].second, full[i].second) << "weight of node " << i;
+    }
+  }
+}
+
+TYPED_TEST(KernelTest, WeightsAloneAreForEachNodesBitForBit) {
+  CheckWeightsAlone<1, TypeParam>();
+  CheckWeightsAlone<2, TypeParam>();
+  CheckWeightsAlone<3, TypeParam>();
 }
 
 TYPED_TEST(KernelTest, GradientsAreConsistent) {
