@@ -99,6 +99,17 @@ class NonlocalLaplacian {
 
  private:
   static constexpr int kComponents = Dim * (Dim + 1) / 2;
+  // The transfer's node records (Stencil::add_to_records): m_i, then q_i m_i (q_i
+  // after the division), then on the anisotropic path A_i's components; padded
+  // so that a row of the stencil's records fills whole 16-byte registers (Strip).
+  static constexpr int padded_width(int values) {
+    int w = values;
+    while (StencilT::S * w * static_cast<int>(sizeof(Real)) % 16 != 0) ++w;
+    return w;
+  }
+  static constexpr int kIsoWidth = padded_width(2);
+  static constexpr int kAnisoWidth = padded_width(2 + kComponents);
+  static constexpr int kM = 0, kQ = 1, kA = 2;  // slots of a record
   // Index of A_ab (either order) among the upper triangle's components.
   static constexpr int comp(int a, int b) {
     return a <= b ? a * Dim - a * (a - 1) / 2 + (b - a) : comp(b, a);
@@ -118,63 +129,57 @@ class NonlocalLaplacian {
   bool requested(const Particles<Dim>& P, std::size_t p) const {
     return requests_[P.material[p]].active();
   }
+  int width() const { return aniso_ ? kAnisoWidth : kIsoWidth; }
+  Real m(long i) const { return records_[i * width() + kM]; }
+  Real q(long i) const { return records_[i * width() + kQ]; }
+  Real A(int c, long i) const { return records_[i * width() + kA + c]; }
 
   // Zeroes the fields over the box of the previous call, then bins the particles
   // at their current positions into a new box: outside it every field is zero.
   void rebin(const State<Dim>& s) {
     const auto& geo = s.grid.geo;
     const auto n = static_cast<std::size_t>(geo.node_count());
-    if (m_.size() != n) {
-      m_.assign(n, 0), q_.assign(n, 0), lap_.assign(n, 0);
-      for (auto& f : A_) f.clear();
+    const int W = width();
+    if (records_.size() != n * W) {  // first call, another grid, or the path changed
+      records_.assign(n * W, 0), lap_.assign(n, 0);
       diag_.clear();
     } else {
       box_.for_each_row(geo.strides(), [&](long first, long count) {
-        std::fill_n(m_.begin() + first, count, Real(0));
-        std::fill_n(q_.begin() + first, count, Real(0));
+        std::fill_n(records_.begin() + first * W, count * W, Real(0));
         std::fill_n(lap_.begin() + first, count, Real(0));
-        if (diag_.empty()) return;
-        for (auto& f : A_) std::fill_n(f.begin() + first, count, Real(0));
-        std::fill_n(diag_.begin() + first, count, Real(0));
+        if (!diag_.empty()) std::fill_n(diag_.begin() + first, count, Real(0));
       });
     }
-    if (aniso_ && diag_.size() != n) {
-      for (auto& f : A_) f.assign(n, 0);
-      diag_.assign(n, 0);
-    }
+    if (aniso_ && diag_.size() != n) diag_.assign(n, 0);
     blocks_.bin(s.particles.x, geo, box_);
   }
 
   void transfer_to_grid(const State<Dim>& s) {
     const auto& P = s.particles;
     const auto& geo = s.grid.geo;
-    Real* const m = m_.data();
-    Real* const q = q_.data();
+    Real* const records = records_.data();
     blocks_.for_each_coloured(s, [&](int p) {
       if (!requested(P, p)) return;
       const LaplacianRequest& r = requests_[P.material[p]];
       const Real mp = P.m[p], mq = mp * P.state_of(p)[r.source];
       const StencilT st(P.x[p], P.F[p], geo);
-      const auto add_mq = [&](long node, Real w) MPMTB_INLINE_LAMBDA {
-        m[node] += w * mp;
-        q[node] += w * mq;
-      };
-      if (!aniso_) {  // the isotropic path, as it always was
-        st.for_each_weight(geo, add_mq);
+      if (!aniso_) {  // the isotropic path
+        const Real value[kIsoWidth] = {mp, mq};
+        st.add_to_records(geo, value, records);
         return;
       }
       const Mat<Dim> mA = mp * structural_tensor(r, P.state_of(p));
-      st.for_each_weight(geo, [&](long node, Real w) {
-        add_mq(node, w);
-        for (int a = 0; a < Dim; ++a) {
-          for (int b = a; b < Dim; ++b) A_[comp(a, b)][node] += w * mA(a, b);
-        }
-      });
+      Real value[kAnisoWidth] = {mp, mq};
+      for (int a = 0; a < Dim; ++a) {
+        for (int b = a; b < Dim; ++b) value[kA + comp(a, b)] = mA(a, b);
+      }
+      st.add_to_records(geo, value, records);
     });
+    const int W = width(), values = aniso_ ? 1 + kComponents : 1;
     box_.for_each_node(geo.strides(), [&](long i) {
-      if (m_[i] > 0) q_[i] /= m_[i];
-      if (aniso_ && m_[i] > 0) {
-        for (int c = 0; c < kComponents; ++c) A_[c][i] /= m_[i];
+      Real* record = records + i * W;
+      if (record[kM] > 0) {
+        for (int c = kQ; c < kQ + values; ++c) record[c] /= record[kM];
       }
     });
   }
@@ -184,15 +189,16 @@ class NonlocalLaplacian {
   void grid_laplacian(const GridGeometry<Dim>& geo) {
     const Real inv_dx2 = 1 / (geo.dx * geo.dx);
     box_.for_each_node(geo.strides(), [&](long i) {
-      if (!(m_[i] > 0)) return;
+      if (!(m(i) > 0)) return;
       const auto idx = geo.multi_index(i);
+      const Real q_i = q(i);
       Real sum = 0;
       for (int a = 0; a < Dim; ++a) {
         const long stride = geo.strides()[a];
         // A neighbour off the grid or without mass mirrors the node (zero flux).
-        const Real lo = idx[a] > 0 && m_[i - stride] > 0 ? q_[i - stride] : q_[i];
-        const Real hi = idx[a] + 1 < geo.nodes(a) && m_[i + stride] > 0 ? q_[i + stride] : q_[i];
-        sum += (hi - q_[i]) + (lo - q_[i]);
+        const Real lo = idx[a] > 0 && m(i - stride) > 0 ? q(i - stride) : q_i;
+        const Real hi = idx[a] + 1 < geo.nodes(a) && m(i + stride) > 0 ? q(i + stride) : q_i;
+        sum += (hi - q_i) + (lo - q_i);
       }
       lap_[i] = sum * inv_dx2;
     });
@@ -204,25 +210,25 @@ class NonlocalLaplacian {
     const int k = idx[a] + dir;
     return k >= 0 && k < geo.nodes(a) ? i + dir * geo.strides()[a] : -1;
   }
-  bool has_mass(long j) const { return j >= 0 && m_[j] > 0; }
+  bool has_mass(long j) const { return j >= 0 && m(j) > 0; }
   // dx F_ab(j) = A_ab,j (q_{j+e_b} - q_{j-e_b}) / 2 at a node j with mass; a
   // neighbour without mass mirrors q_j.
   Real cross_flux(const GridGeometry<Dim>& geo, long j, const std::array<int, Dim>& idx, int a,
                   int b) const {
     const long hi = neighbour(geo, j, idx, b, 1), lo = neighbour(geo, j, idx, b, -1);
-    const Real q_hi = has_mass(hi) ? q_[hi] : q_[j], q_lo = has_mass(lo) ? q_[lo] : q_[j];
-    return A_[comp(a, b)][j] * (q_hi - q_lo) / 2;
+    const Real q_hi = has_mass(hi) ? q(hi) : q(j), q_lo = has_mass(lo) ? q(lo) : q(j);
+    return A(comp(a, b), j) * (q_hi - q_lo) / 2;
   }
 
   // div(A grad q) in flux form (header, step 2), and its diagonal.
   void grid_divergence(const GridGeometry<Dim>& geo) {
     const Real inv_dx2 = 1 / (geo.dx * geo.dx);
     box_.for_each_node(geo.strides(), [&](long i) {
-      if (!(m_[i] > 0)) return;
+      if (!(m(i) > 0)) return;
       const auto idx = geo.multi_index(i);
       Real sum = 0, diagonal = 0;
       for (int a = 0; a < Dim; ++a) {
-        const std::vector<Real>& Aaa = A_[comp(a, a)];
+        const auto Aaa = [&](long j) { return A(comp(a, a), j); };
         Real F_i[Dim] = {};  // the cross fluxes at i, for the ghost -F_ab(i)
         for (int b = 0; b < Dim; ++b) {
           if (b != a) F_i[b] = cross_flux(geo, i, idx, a, b);
@@ -230,9 +236,9 @@ class NonlocalLaplacian {
         for (const int dir : {-1, 1}) {
           const long j = neighbour(geo, i, idx, a, dir);
           const bool inside = has_mass(j);
-          const Real half = inside ? (Aaa[i] + Aaa[j]) / 2 : Aaa[i];
+          const Real half = inside ? (Aaa(i) + Aaa(j)) / 2 : Aaa(i);
           diagonal += half;
-          if (inside) sum += half * (q_[j] - q_[i]);
+          if (inside) sum += half * (q(j) - q(i));
           auto idx_j = idx;
           idx_j[a] += dir;
           for (int b = 0; b < Dim; ++b) {
@@ -256,31 +262,19 @@ class NonlocalLaplacian {
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       if (!requested(P, p)) continue;
-      Real lap = 0, diag = 0;
       const StencilT st(P.x[p], P.F[p], geo);
-      if (aniso_) {
-        st.for_each_weight(geo, [&](long node, Real w) {
-          lap += w * lap_[node];
-          diag += w * diag_[node];
-        });
-      } else {
-        st.for_each_weight(
-            geo, [&](long node, Real w) MPMTB_INLINE_LAMBDA { lap += w * lap_data[node]; });
-      }
       Real* q = P.state_of(p);
       const int target = requests_[P.material[p]].target;
-      q[target] = lap;
-      q[target + 1] = aniso_ ? diag : diagonal;
+      q[target] = st.interpolate(geo, lap_data);
+      q[target + 1] = aniso_ ? st.interpolate(geo, diag_.data()) : diagonal;
     }
   }
 
   std::vector<LaplacianRequest> requests_;
-  bool aniso_ = false;             // any request anisotropic in this call
-  std::vector<Real> m_, q_, lap_;  // over the whole grid, zero outside box_
-  // Anisotropic path only, empty until first used (then zero outside box_):
-  // A's components A_[comp(a, b)], and the operator's diagonal.
-  std::array<std::vector<Real>, kComponents> A_;
-  std::vector<Real> diag_;
+  bool aniso_ = false;  // any request anisotropic in this call
+  // Over the whole grid, zero outside box_: the records (width() per node), and lap_i.
+  std::vector<Real> records_, lap_;
+  std::vector<Real> diag_;  // the anisotropic path's diagonal; empty until first used
   NodeBox<Dim> box_;
   ParticleBlocks<Dim, Kernel> blocks_;
 };

@@ -198,13 +198,34 @@ struct Stencil {
     loop_axis<0>(g.strides(), base_node, Real(1), grad_part, dpos, f);
   }
 
-  // Calls f(node, w_ip) for every node of the stencil, last axis fastest: the
-  // weights alone, with the same products as for_each_node (the same bits), in
-  // a loop that keeps no gradient or offset (perf: the nonlocal transfer's
-  // for_each_node, which read only w, still stored them on the stack).
-  template <class Fn>
-  MPMTB_INLINE void for_each_weight(const GridGeometry<Dim>& g, Fn&& f) const {
-    weight_axis<0>(g.strides(), base_node, Real(1), f);
+  // records[W i + c] += w_ip value[c] for every node i of the stencil, a record
+  // of W values per node (the nonlocal transfer's mass, mass-weighted field and
+  // structural tensor). w_ip is formed as for_each_node forms it (the leading
+  // axes' product, then the last axis's factor) and multiplies each value once,
+  // so every record gets the bits of node-by-node code; the S nodes along the
+  // last axis (stride 1) are one Strip of S W values: a row of the stencil costs
+  // a few loads, adds and stores instead of W per node (perf: the nonlocal
+  // transfer's scalar loop over nodes cost more than P2G's whole scatter).
+  template <int W>
+  MPMTB_INLINE void add_to_records(const GridGeometry<Dim>& g, const Real (&value)[W],
+                                   Real* __restrict records) const {
+    using L = Strip<S * W>;
+    const L w_last = L::from([&](int l) MPMTB_INLINE_LAMBDA { return w(Dim - 1, l / W); });
+    const L v = L::from([&](int l) MPMTB_INLINE_LAMBDA { return value[l % W]; });
+    for_each_row<0>(
+        g.strides(), base_node, Real(1), [&](long first, Real weight) MPMTB_INLINE_LAMBDA {
+          const L w_ip = L::from([&](int) MPMTB_INLINE_LAMBDA { return weight; }) * w_last;
+          Real* out = records + first * W;
+          (L::load(out) + w_ip * v).store(out);
+        });
+  }
+
+  // sum_i w_ip field[i], factored axis by axis,
+  //   sum_k w_0k sum_l w_1l ... sum_m w_(Dim-1)m field[k, l, ..., m]:
+  // short sums of S terms instead of one chain of S^Dim additions (the chain's
+  // latency bounded the nonlocal pass's interpolation back).
+  Real interpolate(const GridGeometry<Dim>& g, const Real* field) const {
+    return interpolate_axis<0>(g.strides(), base_node, field);
   }
 
   // D_p = sum_i w_ip (x_i - x_p)(x_i - x_p)^T. Diagonal for tensor-product kernels
@@ -226,18 +247,33 @@ struct Stencil {
     dwk[k][a] = dw_ak;
     dk[k][a] = d_ak;
   }
-  // Axis A of for_each_weight's loop; `weight` = prod_{b<A} w_b on entry.
+  // Calls f(first node, prod_{b<Dim-1} w_b) for every row of the stencil along
+  // the last axis; `weight` = prod_{b<A} w_b on entry.
   template <int A, class Fn>
-  MPMTB_INLINE void weight_axis(const std::array<long, Dim>& stride, long node, Real weight,
-                                Fn& f) const {
-    for (int k = 0; k < S; ++k) {
-      const long n = node + k * (A == Dim - 1 ? 1 : stride[A]);
-      if constexpr (A == Dim - 1) {
-        f(n, weight * w(A, k));
-      } else {
-        weight_axis<A + 1>(stride, n, weight * w(A, k), f);
-      }
+  MPMTB_INLINE void for_each_row(const std::array<long, Dim>& stride, long node, Real weight,
+                                 Fn&& f) const {
+    if constexpr (A == Dim - 1) {
+      f(node, weight);
+    } else {
+      for (int k = 0; k < S; ++k)
+        for_each_row<A + 1>(stride, node + k * stride[A], weight * w(A, k), f);
     }
+  }
+  // The sum over axes A.. of interpolate().
+  template <int A>
+  MPMTB_INLINE Real interpolate_axis(const std::array<long, Dim>& stride, long node,
+                                     const Real* field) const {
+    const auto term = [&](int k) MPMTB_INLINE_LAMBDA {
+      if constexpr (A == Dim - 1) {
+        return w(A, k) * field[node + k];
+      } else {
+        return w(A, k) * interpolate_axis<A + 1>(stride, node + k * stride[A], field);
+      }
+    };
+    Real sum = term(0);
+#pragma GCC unroll 4
+    for (int k = 1; k < S; ++k) sum += term(k);
+    return sum;
   }
   // Axis A of the tensor-product loop. On entry `weight` is prod_{b<A} w_b and
   // grad_part[a] = dw_a prod_{b<A, b!=a} w_b for a < A.

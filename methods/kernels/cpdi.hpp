@@ -182,10 +182,19 @@ struct Stencil<Dim, CpdiKernel> {
     }
   }
 
-  // Calls f(node, w_ip) for every node of the box (Stencil::for_each_weight).
-  template <class Fn>
-  void for_each_weight(const GridGeometry<Dim>& g, Fn&& f) const {
-    for_each_node(g, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) { f(node, w); });
+  // records[W i + c] += w_ip value[c] and sum_i w_ip field[i] over the box, node
+  // by node (Stencil::add_to_records, Stencil::interpolate).
+  template <int W>
+  void add_to_records(const GridGeometry<Dim>& g, const Real (&value)[W], Real* records) const {
+    for_each_node(g, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
+      for (int c = 0; c < W; ++c) records[node * W + c] += w * value[c];
+    });
+  }
+  Real interpolate(const GridGeometry<Dim>& g, const Real* field) const {
+    Real sum = 0;
+    for_each_node(
+        g, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) { sum += w * field[node]; });
+    return sum;
   }
 
   // D_p = sum_i w_ip (x_i - x_p)(x_i - x_p)^T, full.

@@ -136,32 +136,45 @@ TYPED_TEST(KernelTest, ReproducesConstantAndLinearFields) {
   CheckReproduction<3, TypeParam>();
 }
 
-// Stencil::for_each_weight (the weights-only loop of the nonlocal transfers)
-// visits the nodes of for_each_node in the same order with the same weights,
-// bit for bit: the products are formed in the same order.
+// Stencil::add_to_records (the nonlocal transfer's scatter of node records)
+// adds w_ip value[c] to record c of exactly the stencil's nodes, bit for bit as
+// node by node with for_each_node's weights (a product formed in another order,
+// or a lane of the row given to the wrong node, fails it), on top of what the
+// records held; and Stencil::interpolate (its sum back, factored axis by axis)
+// reproduces a linear field, sum_i w_ip (a + b . x_i) = a + b . x_p.
 template <int Dim, class K>
-void CheckWeightsAlone() {
+void CheckRecordsAndInterpolation() {
   SCOPED_TRACE(::testing::Message() << K::name << ", Dim = " << Dim);
+  constexpr int W = 4;  // a whole number of 16-byte registers per row, every support
   const auto g = TestGrid<Dim>();
+  const Real value[W] = {Real(1.7), Real(-0.3), Real(2.9e3), Real(1) / 3};
+  std::vector<Real> before(g.node_count() * W), linear(g.node_count());
+  Vec<Dim> b;
+  for (int a = 0; a < Dim; ++a) b[a] = Real(0.6) - Real(0.45) * a;
+  for (long i = 0; i < g.node_count(); ++i) {
+    for (int c = 0; c < W; ++c) before[i * W + c] = Real(0.01) * (i % 13) - Real(0.05) * c;
+    linear[i] = Real(2.5) + b.dot(g.position(i));
+  }
   for (const auto& xp : Samples(g)) {
     const Stencil<Dim, K> st(xp, g);
-    std::vector<std::pair<long, Real>> full, alone;
+    std::vector<Real> fast = before, by_node = before;
+    st.add_to_records(g, value, fast.data());
     st.for_each_node(g, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
-      full.emplace_back(node, w);
+      for (int c = 0; c < W; ++c) by_node[node * W + c] += w * value[c];
     });
-    st.for_each_weight(g, [&](long node, Real w) { alone.emplace_back(node, w); });
-    ASSERT_EQ(alone.size(), full.size());
-    for (std::size_t i = 0; i < full.size(); ++i) {
-      EXPECT_EQ(alone[i].first, full[i].first) << "node " << i;
-      EXPECT_EQ(alone[i].second, full[i].second) << "weight of node " << i;
+    for (std::size_t i = 0; i < fast.size(); ++i) {
+      ASSERT_EQ(fast[i], by_node[i]) << "record " << i / W << ", value " << i % W;
     }
+    const Real exact = Real(2.5) + b.dot(xp);
+    EXPECT_NEAR(st.interpolate(g, linear.data()), exact, 1e-12 * (1 + std::abs(exact)))
+        << "linear reproduction";
   }
 }
 
-TYPED_TEST(KernelTest, WeightsAloneAreForEachNodesBitForBit) {
-  CheckWeightsAlone<1, TypeParam>();
-  CheckWeightsAlone<2, TypeParam>();
-  CheckWeightsAlone<3, TypeParam>();
+TYPED_TEST(KernelTest, RecordsAreNodeByNodeBitForBitAndInterpolationIsLinearExact) {
+  CheckRecordsAndInterpolation<1, TypeParam>();
+  CheckRecordsAndInterpolation<2, TypeParam>();
+  CheckRecordsAndInterpolation<3, TypeParam>();
 }
 
 TYPED_TEST(KernelTest, GradientsAreConsistent) {
