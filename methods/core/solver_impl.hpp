@@ -161,59 +161,73 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min, v2_max = 0;
     long non_finite = n, outside = n;
     const Vec<Dim> lo = g.geo.lo, hi = g.geo.hi();  // the closed box of GridGeometry::contains
-#pragma omp parallel for schedule(static) reduction(min                           \
-                                                    : J_min, non_finite, outside) \
-    reduction(max                                                                 \
-              : J_max, v2_max) if (n >= kParallelMinimum)
-    for (long p = 0; p < n; ++p) {
-      const StencilT st(P.x[p], this->domain_F(P, p), g.geo);
-      // kDeform = false: the finish may update F, the motion part keeps it.
-      const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
-        if constexpr (kDeform) {
-          finish_particle();
-        } else {
-          const Mat<Dim> F = P.F[p];
-          finish_particle();
-          P.F[p] = F;
-        }
-      };
-      if constexpr (kFinishRows) {
-        const auto sums = TensorTransfer<Dim, Kernel>::template gather_rows<Policy::gather_terms>(
-            st, g.geo, rows_.data());
-        finish([&]() MPMTB_INLINE_LAMBDA {
-          policy.finish_rows(sums, st, P, static_cast<int>(p), dt);
-        });
-      } else {
-        // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
-        // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
-        typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
-          if constexpr (kTensorPath) {
-            return tensor_gather(policy, st, g.geo, rows_.data());
-          } else {
-            return begin_gather(policy, st);
-          }
-        }();
-        if constexpr (!kTensorPath) {
-          st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
-            policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
-          });
-        }
-        finish([&]() MPMTB_INLINE_LAMBDA { policy.finish(gather, P, static_cast<int>(p), dt); });
-      }
-      // Failure detection, fused into this loop so that it costs nothing extra:
-      // the squared speed (one square root per step, below), and the box test
-      // first, which only a non-finite or escaped position fails.
+    // Failure detection, fused into this loop so that it costs nothing extra:
+    // the squared speed (one square root per step, below), and the box test
+    // first, which only a non-finite or escaped position fails. It runs one
+    // particle behind the transfer: read right after the finish wrote them, F,
+    // v and x came back through store forwarding from the finish's wider
+    // vector stores, which stalled (perf: a sixth of G2P on det F's loads).
+    const auto check = [&](long p, Real& J_lo, Real& J_hi, Real& v2_hi, long& bad,
+                           long& out) MPMTB_INLINE_LAMBDA {
       const Real J = P.F[p].determinant();
-      J_min = std::min(J_min, J);
-      J_max = std::max(J_max, J);
+      J_lo = std::min(J_lo, J);
+      J_hi = std::max(J_hi, J);
       const Real v2 = P.v[p].squaredNorm();
-      v2_max = std::max(v2_max, v2);
+      v2_hi = std::max(v2_hi, v2);
       const bool inside = ((P.x[p].array() >= lo.array()) && (P.x[p].array() <= hi.array())).all();
       if (!std::isfinite(J) || !std::isfinite(v2) || (!inside && !P.x[p].allFinite())) {
-        non_finite = std::min(non_finite, p);
+        bad = std::min(bad, p);
       } else if (!inside) {
-        outside = std::min(outside, p);
+        out = std::min(out, p);
       }
+    };
+#pragma omp parallel reduction(min                           \
+                               : J_min, non_finite, outside) \
+    reduction(max                                            \
+              : J_max, v2_max) if (n >= kParallelMinimum)
+    {
+      long previous = -1;  // this thread's last particle, not yet checked
+#pragma omp for schedule(static) nowait
+      for (long p = 0; p < n; ++p) {
+        const StencilT st(P.x[p], this->domain_F(P, p), g.geo);
+        // kDeform = false: the finish may update F, the motion part keeps it.
+        const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
+          if constexpr (kDeform) {
+            finish_particle();
+          } else {
+            const Mat<Dim> F = P.F[p];
+            finish_particle();
+            P.F[p] = F;
+          }
+        };
+        if constexpr (kFinishRows) {
+          const auto sums = TensorTransfer<Dim, Kernel>::template gather_rows<Policy::gather_terms>(
+              st, g.geo, rows_.data());
+          finish([&]() MPMTB_INLINE_LAMBDA {
+            policy.finish_rows(sums, st, P, static_cast<int>(p), dt);
+          });
+        } else {
+          // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
+          // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
+          typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
+            if constexpr (kTensorPath) {
+              return tensor_gather(policy, st, g.geo, rows_.data());
+            } else {
+              return begin_gather(policy, st);
+            }
+          }();
+          if constexpr (!kTensorPath) {
+            st.for_each_node(g.geo,
+                             [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
+                               policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
+                             });
+          }
+          finish([&]() MPMTB_INLINE_LAMBDA { policy.finish(gather, P, static_cast<int>(p), dt); });
+        }
+        if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
+        previous = p;
+      }
+      if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
     }
     return {J_min, J_max, std::sqrt(v2_max), non_finite == n ? -1 : non_finite,
             outside == n ? -1 : outside};
