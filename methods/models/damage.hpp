@@ -176,12 +176,21 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   Mat<Dim> tau_given_log(const Mat<Dim>& F, Real logJ, const Real* q) const {
     return tau_with(F, logJ, degradation(damage(q)));
   }
+  // The same times V0, into out (ModelBase::kirchhoff_times_volume): entry by
+  // entry, so that nothing is read back from the stack in wider loads.
+  void tau_times_volume_given_log(const Mat<Dim>& F, Real logJ, const Real* q, Real V0,
+                                  Mat<Dim>& out) const {
+    tau_entries(F, logJ, degradation(damage(q)), [&](int i, int j, Real t) { out(i, j) = V0 * t; });
+  }
   // Undamaged Cauchy stress sigma = tau(F, d = 0) / J: the damage driver.
   Mat<Dim> undamaged_cauchy(const Mat<Dim>& F) const {
     return undamaged_cauchy(F, std::log(F.determinant()));
   }
   Mat<Dim> undamaged_cauchy(const Mat<Dim>& F, Real logJ) const {
-    return tau_with(F, logJ, 1) / F.determinant();
+    const Real J = F.determinant();
+    Mat<Dim> sigma;
+    tau_entries(F, logJ, 1, [&](int i, int j, Real t) { sigma(i, j) = t / J; });
+    return sigma;
   }
   Real max_principal_stress(const Mat<Dim>& F) const {
     return max_symmetric_eigenvalue(undamaged_cauchy(F));
@@ -271,11 +280,31 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     return tau_with(F, std::log(F.determinant()), g);
   }
   Mat<Dim> tau_with(const Mat<Dim>& F, Real logJ, Real g) const {
+    Mat<Dim> tau;
+    tau_entries(F, logJ, g, [&](int i, int j, Real t) { tau(i, j) = t; });
+    return tau;
+  }
+  // out(i, j, tau_ij) for every entry of tau = tau_dev + tau_vol with the tensile
+  // part scaled by g, tau_dev = mu (F F^T - s I), tau_vol = (mu (s - 1) + lambda
+  // ln J) I, entry by entry (F F^T is symmetric): written with Eigen's
+  // expressions, the temporaries went through the stack in pieces read back by
+  // wider loads, and half of the stress stalled on store forwarding (perf, the
+  // pinned block).
+  template <class Out>
+  MPMTB_INLINE void tau_entries(const Mat<Dim>& F, Real logJ, Real g, Out&& out) const {
     const Real J = F.determinant(), s = pow_2_over_dim(J, logJ);
-    const Mat<Dim> I = Mat<Dim>::Identity();
-    const Mat<Dim> tau_dev = c_.mu * (F * F.transpose() - s * I);
-    const Mat<Dim> tau_vol = (c_.mu * (s - 1) + c_.lambda * logJ) * I;
-    return J >= 1 ? Mat<Dim>(g * (tau_dev + tau_vol)) : Mat<Dim>(g * tau_dev + tau_vol);
+    const Real vol = c_.mu * (s - 1) + c_.lambda * logJ;
+    const bool tensile = J >= 1;
+    for (int j = 0; j < Dim; ++j) {
+      for (int i = 0; i <= j; ++i) {
+        Real FFt = F(i, 0) * F(j, 0);
+        for (int k = 1; k < Dim; ++k) FFt += F(i, k) * F(j, k);
+        const Real dev = c_.mu * (i == j ? FFt - s : FFt);
+        const Real t = i != j ? g * dev : tensile ? g * (dev + vol) : g * dev + vol;
+        out(i, j, t);
+        if (i != j) out(j, i, t);
+      }
+    }
   }
 
   ElasticConstants c_;

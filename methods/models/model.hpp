@@ -118,7 +118,16 @@ class ModelBase : public ConstitutiveModel<Dim> {
   }
   void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
                               std::vector<Mat<Dim>>& tauV) const override {
-    if constexpr (requires(const Mat<Dim>& F, const Real* q) { self().tau_given_log(F, 0, q); }) {
+    if constexpr (requires(const Mat<Dim>& F, const Real* q, Mat<Dim>& out) {
+                    self().tau_times_volume_given_log(F, 0, q, 1, out);
+                  }) {
+      for_each_with_log(particles, ids, [&](int p, Real logJ) {
+        self().tau_times_volume_given_log(particles.F[p], logJ, particles.state_of(p),
+                                          particles.V0[p], tauV[p]);
+      });
+    } else if constexpr (requires(const Mat<Dim>& F, const Real* q) {
+                           self().tau_given_log(F, 0, q);
+                         }) {
       for_each_with_log(particles, ids, [&](int p, Real logJ) {
         tauV[p] =
             particles.V0[p] * self().tau_given_log(particles.F[p], logJ, particles.state_of(p));
