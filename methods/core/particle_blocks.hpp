@@ -24,6 +24,8 @@ class ParticleBlocks {
   // particle ids by colour, then block (a stable counting sort: particle order
   // within a block).
   void bin(State<Dim>& s) { bin(s.particles.x, s.grid.geo, s.grid.active); }
+  // Sizes the per-particle arrays for n particles ahead of the first bin().
+  void reserve(std::size_t n) { first_.resize(n), block_of_.resize(n), block_order_.resize(n); }
   // The same for positions x on a grid geo: `box` is set to their nodes.
   void bin(const std::vector<Vec<Dim>>& x, const GridGeometry<Dim>& geo, NodeBox<Dim>& box) {
     constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;

@@ -83,6 +83,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     sums_.resize(s.grid.size());
     if constexpr (kTensorPath) rows_.resize(s.grid.size());
     v_rows_.resize(s.grid.size());
+    this->prepare_stages(s);
   }
 
   void particles_to_grid(State<Dim>& s, Real dt) override {

@@ -36,6 +36,9 @@ class SolverStages : public Stepper<Dim> {
   [[gnu::noinline]] void grid_velocities(State<Dim>& s, Real t) override;
   [[gnu::noinline]] StepReport update_deformation(State<Dim>& s, Real dt) override;
   [[gnu::noinline]] void nonlocal_update(State<Dim>& s) override;
+  // The one-time allocations of these stages (Stepper::prepare): P2G's blocks
+  // and the nonlocal Laplacian's fields.
+  [[gnu::noinline]] void prepare_stages(const State<Dim>& s);
 
   // Instantiates every stage for this combination (core/solver_stages_*d.cpp).
   static void instantiate(SolverStages& self, State<Dim>& s);

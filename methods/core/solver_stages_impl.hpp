@@ -156,6 +156,12 @@ void SolverStages<Dim, Kernel, kFold>::nonlocal_update(State<Dim>& s) {
   nonlocal_.apply(s);
 }
 
+template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::prepare_stages(const State<Dim>& s) {
+  blocks_.reserve(s.particles.size());
+  nonlocal_.prepare(s);
+}
+
 // Never called: a qualified (non-virtual) call of each stage instantiates it
 // here, and, not inlined, its code is emitted for the solvers of every transfer
 // to link against.
@@ -166,6 +172,7 @@ void SolverStages<Dim, Kernel, kFold>::instantiate(SolverStages& self, State<Dim
   self.S::grid_velocities(s, 0);
   self.S::update_deformation(s, 0);
   self.S::nonlocal_update(s);
+  self.S::prepare_stages(s);
   self.S::compute_stresses(s);
   self.S::clear_active_box(s.grid);
   self.S::bin(s);
