@@ -30,25 +30,40 @@ class ParticleBlocks {
   void bin(const std::vector<Vec<Dim>>& x, const GridGeometry<Dim>& geo, NodeBox<Dim>& box) {
     constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
     const long n = static_cast<long>(x.size());
-    const Real inv_dx = geo.inv_dx;
-    int lo[Dim], hi[Dim];
-    std::fill_n(lo, Dim, std::numeric_limits<int>::max());
-    std::fill_n(hi, Dim, std::numeric_limits<int>::min());
     first_.resize(n);
+    // The first stencil node per axis, as in Stencil, clamped so that a stray
+    // particle cannot index out of range: every axis at once, one per lane of an
+    // AxisPack (the same operations lane by lane: perf showed the axis-by-axis
+    // loop, with its branches for the bounds, at three quarters of the binning).
+    AxisPack origin{}, low{}, high{};
+    for (int a = 0; a < Dim; ++a) {
+      origin[a] = geo.lo[a];
+      low[a] = Real(-pad);
+      high[a] = Real(geo.cells[a] + pad);
+    }
+    const Real inv_dx = geo.inv_dx, shift = Real(0.5) * (S - 2);  // Stencil::first_index
+    AxisInts lo = AxisInts{} + std::numeric_limits<int>::max();
+    AxisInts hi = AxisInts{} + std::numeric_limits<int>::min();
     // Min and max are exact, so the box does not depend on the thread count.
-#pragma omp parallel for schedule(static) reduction(min         \
-                                                    : lo[:Dim]) \
-    reduction(max                                               \
-              : hi[:Dim]) if (n >= kParallelMinimum)
-    for (long p = 0; p < n; ++p) {
-      for (int a = 0; a < Dim; ++a) {
-        // As in Stencil, clamped so that a stray particle cannot index out of range.
-        const Real xi =
-            std::clamp((x[p][a] - geo.lo[a]) * inv_dx, Real(-pad), Real(geo.cells[a] + pad));
-        const int f = StencilT::first_index(xi) + pad;
-        lo[a] = std::min(lo[a], f);
-        hi[a] = std::max(hi[a], f);
-        if (a < kColouredAxes) first_[p][a] = f;
+#pragma omp parallel if (n >= kParallelMinimum)
+    {
+      AxisInts lo_t = lo, hi_t = hi;
+#pragma omp for schedule(static) nowait
+      for (long p = 0; p < n; ++p) {
+        AxisPack xp{};
+        for (int a = 0; a < Dim; ++a) xp[a] = x[p][a];
+        AxisPack xi = (xp - origin) * inv_dx;
+        xi = xi < low ? low : xi;  // std::clamp's comparisons
+        xi = high < xi ? high : xi;
+        const AxisInts f = axis_floor(xi - shift) + pad;
+        lo_t = f < lo_t ? f : lo_t;
+        hi_t = hi_t < f ? f : hi_t;
+        for (int a = 0; a < kColouredAxes; ++a) first_[p][a] = f[a];
+      }
+#pragma omp critical(mpmtb_bin_box)
+      {
+        lo = lo_t < lo ? lo_t : lo;
+        hi = hi < hi_t ? hi_t : hi;
       }
     }
     for (int a = 0; a < Dim; ++a) {
@@ -91,7 +106,17 @@ class ParticleBlocks {
       fill_.assign(threads * blocks, 0);  // then the implicit barrier
       int* mine = &fill_[t * blocks];
       const long from = n * t / threads, to = n * (t + 1) / threads;
-      for (long p = from; p < to; ++p) ++mine[block_of_[p]];
+      // Consecutive particles mostly share a block (the setup's lattice order runs
+      // along the last axis, which the blocks do not split): the counts and the
+      // places go by runs of one block, kept in a register, instead of a load of
+      // the count that the previous particle has just stored.
+      for (long p = from; p < to;) {
+        const int b = block_of_[p];
+        long end = p + 1;
+        while (end < to && block_of_[end] == b) ++end;
+        mine[b] += static_cast<int>(end - p);
+        p = end;
+      }
 #pragma omp barrier
 #pragma omp single
       {
@@ -106,7 +131,12 @@ class ParticleBlocks {
         }
         block_start_[blocks] = start;
       }
-      for (long p = from; p < to; ++p) block_order_[mine[block_of_[p]]++] = static_cast<int>(p);
+      for (long p = from; p < to;) {
+        const int b = block_of_[p];
+        int place = mine[b];
+        for (; p < to && block_of_[p] == b; ++p) block_order_[place++] = static_cast<int>(p);
+        mine[b] = place;
+      }
     }
   }
 

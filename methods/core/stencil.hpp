@@ -82,6 +82,28 @@ inline Pack axis_sqrt(Pack x) {
 #endif
 }
 
+// Four int lanes, one per axis (AxisPack's lanes as integers).
+typedef int AxisInts __attribute__((vector_size(16)));
+
+// The lanes rounded down, as ints (std::floor and the conversion, lane by lane;
+// the lanes are within int range where used).
+template <class Pack = AxisPack>
+inline AxisInts axis_floor(Pack x) {
+#if defined(__AVX__)
+  if constexpr (sizeof(Pack) == 32) {
+    const __m256d down = _mm256_round_pd(reinterpret_cast<__m256d>(x), _MM_FROUND_FLOOR);
+    return reinterpret_cast<AxisInts>(_mm256_cvttpd_epi32(down));
+  } else {
+    const __m128 down = _mm_round_ps(reinterpret_cast<__m128>(x), _MM_FROUND_FLOOR);
+    return reinterpret_cast<AxisInts>(_mm_cvttps_epi32(down));
+  }
+#else
+  AxisInts out;
+  for (int a = 0; a < 4; ++a) out[a] = static_cast<int>(std::floor(x[a]));
+  return out;
+#endif
+}
+
 // Kernels whose branch-free weights() takes any value type: the stencil then
 // evaluates every axis at once, one axis per lane of an AxisPack.
 template <class Kernel>
