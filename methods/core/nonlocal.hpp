@@ -84,7 +84,7 @@ class NonlocalLaplacian {
   void prepare(const State<Dim>& s) {
     if (!read_requests(s)) return;
     size_fields(s.grid.geo);
-    blocks_.reserve(s.particles.size());
+    blocks_.size_for(s.particles.size());
   }
 
   void apply(State<Dim>& s) {

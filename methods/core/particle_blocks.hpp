@@ -24,8 +24,8 @@ class ParticleBlocks {
   // particle ids by colour, then block (a stable counting sort: particle order
   // within a block).
   void bin(State<Dim>& s) { bin(s.particles.x, s.grid.geo, s.grid.active); }
-  // Sizes the per-particle arrays for n particles ahead of the first bin().
-  void reserve(std::size_t n) { first_.resize(n), block_of_.resize(n), block_order_.resize(n); }
+  // Sizes (and touches) the per-particle arrays for n particles ahead of the first bin().
+  void size_for(std::size_t n) { first_.resize(n), block_of_.resize(n), block_order_.resize(n); }
   // The same for positions x on a grid geo: `box` is set to their nodes.
   void bin(const std::vector<Vec<Dim>>& x, const GridGeometry<Dim>& geo, NodeBox<Dim>& box) {
     constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
@@ -41,7 +41,7 @@ class ParticleBlocks {
       low[a] = Real(-pad);
       high[a] = Real(geo.cells[a] + pad);
     }
-    const Real inv_dx = geo.inv_dx, shift = Real(0.5) * (S - 2);  // Stencil::first_index
+    const Real inv_dx = geo.inv_dx;
     AxisInts lo = AxisInts{} + std::numeric_limits<int>::max();
     AxisInts hi = AxisInts{} + std::numeric_limits<int>::min();
     // Min and max are exact, so the box does not depend on the thread count.
@@ -55,7 +55,7 @@ class ParticleBlocks {
         AxisPack xi = (xp - origin) * inv_dx;
         xi = xi < low ? low : xi;  // std::clamp's comparisons
         xi = high < xi ? high : xi;
-        const AxisInts f = axis_floor(xi - shift) + pad;
+        const AxisInts f = StencilT::first_indices(xi) + pad;
         lo_t = f < lo_t ? f : lo_t;
         hi_t = hi_t < f ? f : hi_t;
         for (int a = 0; a < kColouredAxes; ++a) first_[p][a] = f[a];

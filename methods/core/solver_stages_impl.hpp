@@ -158,7 +158,7 @@ void SolverStages<Dim, Kernel, kFold>::nonlocal_update(State<Dim>& s) {
 
 template <int Dim, class Kernel, bool kFold>
 void SolverStages<Dim, Kernel, kFold>::prepare_stages(const State<Dim>& s) {
-  blocks_.reserve(s.particles.size());
+  blocks_.size_for(s.particles.size());
   nonlocal_.prepare(s);
 }
 

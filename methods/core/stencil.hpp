@@ -130,6 +130,8 @@ struct Stencil {
   // Index (unpadded) of the first node of the support along one axis, for a
   // position xi in cell units.
   static int first_index(Real xi) { return static_cast<int>(std::floor(xi - Real(0.5) * (S - 2))); }
+  // The same for every axis at once, axis a in lane a (the binning's).
+  static AxisInts first_indices(AxisPack xi) { return axis_floor(xi - Real(0.5) * (S - 2)); }
 
   MPMTB_INLINE Stencil(const Vec<Dim>& xp, const GridGeometry<Dim>& g) {
     if constexpr (!kernel_uses_half_width<Kernel> && kernel_weights_by_axes<Kernel>) {

@@ -105,6 +105,8 @@ struct Stencil<Dim, CpdiKernel> {
   // for the cubic B-spline: ParticleBlocks colours by it. The box starts there
   // or one node later (the domain's half-extent is below one cell).
   static int first_index(Real xi) { return static_cast<int>(std::floor(xi - Real(1))); }
+  // The same for every axis at once, axis a in lane a (the binning's).
+  static AxisInts first_indices(AxisPack xi) { return axis_floor(xi - Real(1)); }
 
   // The undeformed domain (F = I).
   Stencil(const Vec<Dim>& xp, const GridGeometry<Dim>& g) : Stencil(xp, Mat<Dim>::Identity(), g) {}
