@@ -77,6 +77,18 @@ MPMTB_INLINE inline Pack fused(Pack x, Pack y, Pack z) {
   return r;
 }
 
+// Lane I of a pack in every lane of a pack of type To (of any width): one
+// shuffle or broadcast in registers, where reading the lane out as a Real and
+// broadcasting it back took two or three (and often a trip through the stack).
+template <int I, class To, class From>
+MPMTB_INLINE inline To splat(From from) {
+  constexpr int lanes = sizeof(To) / sizeof(Real);
+  return [&]<int... l>(std::integer_sequence<int, l...>) MPMTB_INLINE_LAMBDA {
+    return __builtin_shufflevector(from, from, (l * 0 + I)...);
+  }
+  (std::make_integer_sequence<int, lanes>{});
+}
+
 // N reals (N * sizeof(Real) a multiple of 16 bytes) as K registers.
 template <int N>
 struct Row {
@@ -127,6 +139,12 @@ struct Row {
   // so that every transfer that sums through a Row rounds the same way.
   MPMTB_INLINE void add_scaled(Real s, const Row& a) {
     const Pack sp = s - Pack{};  // s in every lane
+    for (int k = 0; k < K; ++k) v[k] = fused(sp, a.v[k], v[k]);
+  }
+  // *this += s a with s = lane I of the pack `from` (splat: the same value).
+  template <int I, class From>
+  MPMTB_INLINE void add_scaled_lane(From from, const Row& a) {
+    const Pack sp = splat<I, Pack>(from);
     for (int k = 0; k < K; ++k) v[k] = fused(sp, a.v[k], v[k]);
   }
 };
@@ -204,6 +222,14 @@ struct Strip {
     s.tail = Strip<N - lanes>::fma(a, b.tail, c.tail);
     return s;
   }
+  // a b + c with a = lane I of the pack `from` in every lane (splat).
+  template <int I, class From>
+  MPMTB_INLINE static Strip fma_lane(From from, const Strip& b, const Strip& c) {
+    Strip s;
+    s.head = fused(splat<I, Pack>(from), b.head, c.head);
+    s.tail = Strip<N - lanes>::template fma_lane<I>(from, b.tail, c.tail);
+    return s;
+  }
   // Lane l of the strip.
   MPMTB_INLINE Real operator[](int l) const { return l < lanes ? head[l] : tail[l - lanes]; }
   // Lanes First .. First + W - 1 as a Row, in registers.
@@ -231,6 +257,10 @@ struct Strip<0> {
   MPMTB_INLINE friend Strip operator+(const Strip&, const Strip&) { return {}; }
   MPMTB_INLINE static Strip fma(const Strip&, const Strip&, const Strip&) { return {}; }
   MPMTB_INLINE static Strip fma(Real, const Strip&, const Strip&) { return {}; }
+  template <int I, class From>
+  MPMTB_INLINE static Strip fma_lane(From, const Strip&, const Strip&) {
+    return {};
+  }
   MPMTB_INLINE Real operator[](int) const { return 0; }
 };
 

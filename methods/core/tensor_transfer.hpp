@@ -17,6 +17,7 @@
 
 #include <algorithm>
 #include <type_traits>
+#include <utility>
 #include <vector>
 
 #include "core/pack.hpp"
@@ -386,31 +387,59 @@ class TensorTransfer {
     }
     Real md[Dim] = {}, gd[Dim] = {};
     prefix_rows<0, T>(st, wd, stride, st.base_node, 0, rows, nodal, Real(1), md, gd, acc);
-    Real w_last[S], wd_last[S], dw_last[S];
-    for (int k = 0; k < S; ++k) {
-      w_last[k] = st.w(B, k);
-      wd_last[k] = wd[k][B];
-      dw_last[k] = st.dw(B, k);
-    }
-    out.W = reduce_last<GR>(acc.W, w_last);
+    out.W = reduce_last<GR>(acc.W, st.wk);
     for (int a = 0; a < B; ++a) {
-      if constexpr (T.moment) out.Dm[a] = reduce_last<GR>(acc.Dm[a], w_last);
-      if constexpr (T.gradient) out.Gr[a] = reduce_last<GR>(acc.Gr[a], w_last);
+      if constexpr (T.moment) out.Dm[a] = reduce_last<GR>(acc.Dm[a], st.wk);
+      if constexpr (T.gradient) out.Gr[a] = reduce_last<GR>(acc.Gr[a], st.wk);
     }
-    if constexpr (T.moment) out.Dm[B] = reduce_last<GR>(acc.W, wd_last);
-    if constexpr (T.gradient) out.Gr[B] = reduce_last<GR>(acc.W, dw_last);
+    if constexpr (T.moment) out.Dm[B] = reduce_last<GR>(acc.W, wd);
+    if constexpr (T.gradient) out.Gr[B] = reduce_last<GR>(acc.W, st.dwk);
   }
-  // Along the last axis: sum_k c_k (row k of the strip), c_k the factor of node k.
+  // Along the last axis: sum_k c_k (row k of the strip), c_k the last axis's
+  // factor of node k (lane Dim - 1 of f[k], the stencil's node-major factors).
   template <class GR, class L>
-  MPMTB_INLINE static GR reduce_last(const L& strip, const Real (&c)[S]) {
-    constexpr int N = GR::count;
+  MPMTB_INLINE static GR reduce_last(const L& strip, const AxisPack (&f)[S]) {
+    constexpr int N = GR::count, B = Dim - 1;
     GR r = GR::zero();
-    r.add_scaled(c[0], strip.template segment<0, N>());
-    if constexpr (S > 1) r.add_scaled(c[1], strip.template segment<N, N>());
-    if constexpr (S > 2) r.add_scaled(c[2], strip.template segment<2 * N, N>());
-    if constexpr (S > 3) r.add_scaled(c[3], strip.template segment<3 * N, N>());
+    r.template add_scaled_lane<B>(f[0], strip.template segment<0, N>());
+    if constexpr (S > 1) r.template add_scaled_lane<B>(f[1], strip.template segment<N, N>());
+    if constexpr (S > 2) r.template add_scaled_lane<B>(f[2], strip.template segment<2 * N, N>());
+    if constexpr (S > 3) r.template add_scaled_lane<B>(f[3], strip.template segment<3 * N, N>());
     static_assert(S <= 4, "kernels of up to 4 nodes per axis");
     return r;
+  }
+  // Axis A's factors of the S nodes, node k in lane k (f node-major, axis a in
+  // lane a: the stencil's layout).
+  // Lanes S.. are copies of others (never read). Two or three shuffles.
+  template <int A>
+  MPMTB_INLINE static AxisPack axis_factors(const AxisPack (&f)[S]) {
+    static_assert(S >= 2 && S <= 4, "an AxisPack holds 2 to 4 nodes");
+    const AxisPack f01 = __builtin_shufflevector(f[0], f[1], A, 4 + A, A, 4 + A);
+    if constexpr (S == 2) {
+      return f01;
+    } else if constexpr (S == 3) {
+      return __builtin_shufflevector(f01, f[2], 0, 1, 4 + A, 4 + A);
+    } else {
+      const AxisPack f23 = __builtin_shufflevector(f[2], f[3], A, 4 + A, A, 4 + A);
+      return __builtin_shufflevector(f01, f23, 0, 1, 4, 5);
+    }
+  }
+  // Row K of the last leading axis (prefix_rows): its factors in lane K of w,
+  // md and gd.
+  template <int K, TensorTerms T>
+  MPMTB_INLINE static void last_row(long node, int j, const Real* __restrict rows,
+                                    Real* __restrict nodal, const AxisPack& w,
+                                    const AxisPack (&md)[Dim], const AxisPack (&gd)[Dim],
+                                    RowSums<T>& acc) {
+    using L = typename RowSums<T>::L;
+    constexpr int N = VR<T>::N, A = Dim - 1;
+    const L row = L::load(rows + node * N);
+    if constexpr (T.nodal) row.store(nodal + j * S * N);
+    acc.W = L::template fma_lane<K>(w, row, acc.W);
+    for (int a = 0; a < A; ++a) {
+      if constexpr (T.moment) acc.Dm[a] = L::template fma_lane<K>(md[a], row, acc.Dm[a]);
+      if constexpr (T.gradient) acc.Gr[a] = L::template fma_lane<K>(gd[a], row, acc.Gr[a]);
+    }
   }
   // Axis A < Dim - 1 of the rows' prefix: w = prod_{b<A} w_b, md[a] (gd[a]) the
   // same product with w_a d_a (dw_a) for axis a < A; j the stencil index of the
@@ -431,6 +460,23 @@ class TensorTransfer {
         if constexpr (T.moment) acc.Dm[a] = L::fma(md[a], row, acc.Dm[a]);
         if constexpr (T.gradient) acc.Gr[a] = L::fma(gd[a], row, acc.Gr[a]);
       }
+    } else if constexpr (A == Dim - 2) {
+      // The last leading axis: the factors of its S rows at once, row k in lane
+      // k (the same products as below, lane by lane), then splat into each
+      // row's sums: the per-row scalars had gone through the stack.
+      const AxisPack wA = axis_factors<A>(st.wk);
+      const AxisPack wv = w * wA;
+      AxisPack mdv[Dim], gdv[Dim];
+      for (int a = 0; a < A; ++a) {
+        if constexpr (T.moment) mdv[a] = md[a] * wA;
+        if constexpr (T.gradient) gdv[a] = gd[a] * wA;
+      }
+      if constexpr (T.moment) mdv[A] = w * axis_factors<A>(wd);
+      if constexpr (T.gradient) gdv[A] = w * axis_factors<A>(st.dwk);
+      [&]<int... k>(std::integer_sequence<int, k...>) MPMTB_INLINE_LAMBDA {
+        (last_row<k, T>(node + k * stride[A], j * S + k, rows, nodal, wv, mdv, gdv, acc), ...);
+      }
+      (std::make_integer_sequence<int, S>{});
     } else {
       for (int k = 0; k < S; ++k) {
         const Real wk = st.w(A, k);
