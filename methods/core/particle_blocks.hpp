@@ -11,6 +11,7 @@
 
 #include "core/state.hpp"
 #include "core/stencil.hpp"
+#include "core/thread_split.hpp"
 
 namespace mpmtb {
 
@@ -153,29 +154,40 @@ class ParticleBlocks {
   void for_each_coloured(const State<Dim>& s, Scatter&& scatter) const {
     const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
     const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
+    split_.open();
+    int threads_used = 1;
 #pragma omp parallel if (parallel)
     {
-      const long threads = omp_get_num_threads(), t = omp_get_thread_num();
+      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+      if (t == 0) threads_used = threads;
+      double busy = 0;  // this thread's time in its blocks, without the barriers
+      long scattered = 0;
       for (int colour = 0; colour < kColours; ++colour) {
         const auto first = block_start_.begin() + colour * per_colour;
         const auto last = first + per_colour;
         const long count = *last - *first;
         // The block boundary nearest to the thread's share of the particles (the
-        // first block at or after it left up to a whole block's imbalance).
-        const auto share = [&](long k) {
+        // first block at or after it left up to a whole block's imbalance); the
+        // shares follow the threads' speeds in the last call (ThreadSplit).
+        const auto share = [&](int k) {
           if (k == threads) return last;
-          const int target = static_cast<int>(*first + count * k / threads);
+          const int target = static_cast<int>(*first + split_.cut(k, threads, count));
           const auto after = std::lower_bound(first, last, target);
           if (after == first) return after;
           return target - *(after - 1) < *after - target ? after - 1 : after;
         };
         const auto from = share(t), to = share(t + 1);
+        const double start = omp_get_wtime();
         for (auto b = from; b != to; ++b) {
           for (int k = *b; k < *(b + 1); ++k) scatter(block_order_[k]);
         }
+        busy += omp_get_wtime() - start;
+        scattered += *to - *from;
 #pragma omp barrier
       }
+      split_.record(t, scattered, busy);
     }
+    split_.close(threads_used);
   }
 
  private:
@@ -186,6 +198,7 @@ class ParticleBlocks {
   static constexpr int kColours = 1 << kColouredAxes;
   std::vector<std::array<int, kColouredAxes>> first_;  // first stencil node per coloured axis
   std::vector<int> block_of_, block_start_, block_order_, fill_;
+  mutable ThreadSplit split_;  // the threads' shares of each colour's particles
 };
 
 }  // namespace mpmtb

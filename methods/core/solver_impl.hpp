@@ -16,6 +16,7 @@
 #include "core/solver_stages.hpp"
 #include "core/stencil.hpp"
 #include "core/tensor_transfer.hpp"
+#include "core/thread_split.hpp"
 #include "kernels/all.hpp"
 
 namespace mpmtb {
@@ -185,16 +186,23 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
         out = std::min(out, p);
       }
     };
+    // Contiguous shares of the particles, sized by the threads' speeds in the
+    // last G2P (core/thread_split.hpp).
+    gather_split_.open();
+    int threads_used = 1;
 #pragma omp parallel reduction(min                           \
                                : J_min, non_finite, outside) \
     reduction(max                                            \
               : J_max, v2_max) if (n >= kParallelMinimum)
     {
+      const int threads = omp_get_num_threads(), t = omp_get_thread_num();
+      if (t == 0) threads_used = threads;
+      const auto [from, to] = gather_split_.range(t, threads, n);
+      const double start = omp_get_wtime();
       long previous = -1;  // this thread's last particle, not yet checked
-#pragma omp for schedule(static) nowait
-      for (long p0 = 0; p0 < n; p0 += kRun) {
+      for (long p0 = from; p0 < to; p0 += kRun) {
         for_each_in_run(
-            P, g.geo, p0, std::min<long>(kRun, n - p0),
+            P, g.geo, p0, std::min<long>(kRun, to - p0),
             [&](long p, const StencilT& st) MPMTB_INLINE_LAMBDA {
               // kDeform = false: the finish may update F, the motion part keeps it.
               const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
@@ -238,7 +246,9 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
             });
       }
       if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
+      gather_split_.record(t, to - from, omp_get_wtime() - start);
     }
+    gather_split_.close(threads_used);
     return {J_min, J_max, std::sqrt(v2_max), non_finite == n ? -1 : non_finite,
             outside == n ? -1 : outside};
   }
@@ -395,6 +405,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     }
   }();
   VelocityRows<Dim, kGatherOld> rows_;
+  ThreadSplit gather_split_;  // G2P's shares of the particles per thread
   // Scratch of filter_old_velocity: nodal field, sums and masses; particle values.
   std::vector<Vec<Dim>> q_field_, q_sum_, q_particle_;
   std::vector<Real> q_mass_;
