@@ -408,9 +408,9 @@ class TensorTransfer {
     static_assert(S <= 4, "kernels of up to 4 nodes per axis");
     return r;
   }
-  // Axis A's factors of the S nodes, node k in lane k (f node-major, axis a in
-  // lane a: the stencil's layout).
-  // Lanes S.. are copies of others (never read). Two or three shuffles.
+  // Axis A's factors of the S nodes, node k in lane k, from f node-major (axis
+  // a in lane a: the stencil's layout), in two or three shuffles; lanes S and
+  // above hold copies (never read).
   template <int A>
   MPMTB_INLINE static AxisPack axis_factors(const AxisPack (&f)[S]) {
     static_assert(S >= 2 && S <= 4, "an AxisPack holds 2 to 4 nodes");
