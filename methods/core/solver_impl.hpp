@@ -9,6 +9,7 @@
 #include <cstdint>
 #include <limits>
 #include <new>
+#include <type_traits>
 #include <utility>
 
 #include "core/policy_hooks.hpp"
@@ -299,6 +300,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   template <class F>
   MPMTB_INLINE void for_each_in_run(const Particles<Dim>& P, const GridGeometry<Dim>& geo,
                                     long first, long count, F&& f) const {
+    static_assert(std::is_trivially_destructible_v<StencilT>, "the run never destroys them");
     alignas(StencilT) unsigned char bytes[kRun * sizeof(StencilT)];
     StencilT* const run = reinterpret_cast<StencilT*>(bytes);
     for (long i = 0; i < count; ++i)

@@ -45,24 +45,25 @@ class ThreadSplit {
   }
   // Serially, after the region: the next shares, each thread's in proportion
   // to its measured items per second, averaged with the current shares (one
-  // slow step, an interrupt, moves them by half of its effect).
+  // slow step, an interrupt, moves them by half of its effect). In place: no
+  // allocation in the steps, but where the thread count changed.
   void close(int threads) {
-    std::vector<double> share(threads, 1.0 / threads);
-    if (static_cast<int>(start_.size()) == threads + 1) {
-      for (int t = 0; t < threads; ++t) share[t] = start_[t + 1] - start_[t];
-    }
     double total = 0;
-    std::vector<double> speed(threads, 0);
     for (int t = 0; t < threads; ++t) {
       if (!(seconds_[t] > 0) || items_[t] <= 0) return;  // nothing measured: keep
-      speed[t] = static_cast<double>(items_[t]) / seconds_[t];
-      total += speed[t];
+      total += speed(t);
     }
-    start_.assign(threads + 1, 0);
+    if (static_cast<int>(start_.size()) != threads + 1) {  // even shares to start from
+      start_.resize(threads + 1);
+      for (int k = 0; k <= threads; ++k) start_[k] = static_cast<double>(k) / threads;
+    }
+    double old_start = start_[0];
     for (int t = 0; t < threads; ++t) {
+      const double share = start_[t + 1] - old_start;
+      old_start = start_[t + 1];
       // No thread below a quarter of the even share: a stalled measurement
       // must not starve a thread.
-      const double next = std::max(0.5 * (share[t] + speed[t] / total), 0.25 / threads);
+      const double next = std::max(0.5 * (share + speed(t) / total), 0.25 / threads);
       start_[t + 1] = start_[t] + next;
     }
     for (int t = 1; t <= threads; ++t) start_[t] /= start_[threads];
@@ -72,6 +73,8 @@ class ThreadSplit {
   std::vector<double> start_;  // cumulative shares, threads + 1 of them (empty: even)
   std::vector<double> seconds_;
   std::vector<long> items_;
+
+  double speed(int t) const { return static_cast<double>(items_[t]) / seconds_[t]; }
 };
 
 }  // namespace mpmtb
