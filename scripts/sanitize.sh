@@ -22,9 +22,17 @@
 # The heaviest tests (grids of 128^2 and 64^3 and more, runs of thousands of
 # steps) are left out: they run the same code as their small 1D, 2D and 3D
 # siblings, which do run here.
+# SANITIZE_STAGE=build only builds the tree, SANITIZE_STAGE=test only runs its
+# tests (scripts/test.sh builds it in the background while the Release tests
+# run); unset, both.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$(date +%s)
+stage=${SANITIZE_STAGE:-all}
+case "$stage" in build | test | all) ;; *)
+  echo "sanitize.sh: SANITIZE_STAGE=$stage; allowed: build, test, all" >&2
+  exit 2 ;;
+esac
 source scripts/ccache.sh
 cxx=${CXX_SANITIZE:-clang++}
 command -v "$cxx" >/dev/null || cxx=g++
@@ -36,12 +44,15 @@ if [[ $cxx == *clang* ]]; then
 else
   debug_flags="-O0 -g1"
 fi
-cmake -S . -B build-asan -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
-  -DCMAKE_CXX_FLAGS_DEBUG="$debug_flags" -DMPMTB_METHODS_OPT=-O1 \
-  -DMPMTB_SANITIZE="$sanitizers" -DMPMTB_NO_SANITIZE="$no_sanitize" \
-  -DMPMTB_WERROR=ON -DMPMTB_BUILD_BENCH=OFF "${extra[@]}" "${launcher[@]}" "$@" >/dev/null
-cmake --build build-asan -j "$(nproc)" --target "${targets[@]}"
-echo "sanitizer stage: built with $cxx in $(( $(date +%s) - start )) s"
+if [ "$stage" != test ]; then
+  cmake -S . -B build-asan -DCMAKE_CXX_COMPILER="$cxx" -DCMAKE_BUILD_TYPE=Debug \
+    -DCMAKE_CXX_FLAGS_DEBUG="$debug_flags" -DMPMTB_METHODS_OPT=-O1 \
+    -DMPMTB_SANITIZE="$sanitizers" -DMPMTB_NO_SANITIZE="$no_sanitize" \
+    -DMPMTB_WERROR=ON -DMPMTB_BUILD_BENCH=OFF "${extra[@]}" "${launcher[@]}" "$@" >/dev/null
+  cmake --build build-asan -j "$(nproc)" --target "${targets[@]}"
+  echo "sanitizer stage: built with $cxx in $(( $(date +%s) - start )) s"
+fi
+[ "$stage" != build ] || exit 0
 export ASAN_OPTIONS=abort_on_error=0:detect_leaks=1:strict_string_checks=1
 export UBSAN_OPTIONS=print_stacktrace=1:halt_on_error=1
 # The shards share the cores: OpenMP threads sleep at barriers (tests/CMakeLists.txt).
