@@ -14,9 +14,13 @@ bash scripts/setup-deps.sh
 # compilations alone fill 2 cores for about 15 minutes, so every idle second counts.
 mkdir -p build-asan
 asan_log=build-asan/stage-build.log
-SANITIZE_STAGE=build setsid nice -n 19 bash scripts/sanitize.sh >"$asan_log" 2>&1 &
+# Its own process group (job control, set -m), so that a failure below stops
+# the whole build; not its own session (setsid), which the kernel's autogroup
+# scheduling would give an equal share of the cores whatever its nice value.
+set -m
+SANITIZE_STAGE=build nice -n 19 bash scripts/sanitize.sh >"$asan_log" 2>&1 &
 asan_build=$!
-# A failure below stops the background build too (its own process group).
+set +m
 trap 'kill -- -"$asan_build" 2>/dev/null || true' EXIT
 # Only what the default set runs: not the sweep tests or the benchmarks.
 MPMTB_TARGETS="mpmtb mpmtb_unit_tests mpmtb_verification_tests" bash scripts/build.sh
@@ -30,6 +34,20 @@ if ! wait "$asan_build"; then
 fi
 trap - EXIT
 tail -n 1 "$asan_log"
+# Bounded coverage-guided fuzz of the scene parser (libFuzzer; skipped without
+# clang), one process, beside the sanitized tests' two shards: three processes
+# keep both cores busy until the last ends.
+fuzz_log=build-asan/stage-fuzz.log
+set -m
+FUZZ_TREE=build-asan bash scripts/fuzz.sh 200000 120 >"$fuzz_log" 2>&1 &
+fuzz=$!
+set +m
+trap 'kill -- -"$fuzz" 2>/dev/null || true' EXIT
 SANITIZE_STAGE=test bash scripts/sanitize.sh
-# Bounded coverage-guided fuzz of the scene parser (libFuzzer; skipped without clang).
-FUZZ_TREE=build-asan bash scripts/fuzz.sh 200000 60
+if ! wait "$fuzz"; then
+  cat "$fuzz_log"
+  echo "fuzz: failed (above)"
+  exit 1
+fi
+trap - EXIT
+grep -E '^(Done|fuzz:)' "$fuzz_log" || tail -n 3 "$fuzz_log"
