@@ -23,8 +23,8 @@
 # steps) are left out: they run the same code as their small 1D, 2D and 3D
 # siblings, which do run here.
 # SANITIZE_STAGE=build only builds the tree, SANITIZE_STAGE=test only runs its
-# tests (scripts/test.sh builds it in the background while the Release tests
-# run); unset, both.
+# tests (scripts/test.sh, which runs the fuzz stage beside the tests); unset,
+# both.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 start=$(date +%s)
