@@ -3,9 +3,23 @@
 #include <fmt/format.h>
 #include <fmt/ranges.h>
 
+#include <optional>
+
 #include "core/errors.hpp"
 
 namespace mpmtb {
+namespace {
+
+// A TOML number as a real. toml++'s value<double>() is empty for an integer
+// that a double cannot hold exactly (beyond 2^53; the scene fuzz target found
+// E = 39647841760435743 ending the program): such an integer is read at the
+// nearest double, as the same number written with a decimal point would be.
+std::optional<double> real_of(const toml::node& n) {
+  if (const auto* i = n.as_integer()) return static_cast<double>(i->get());
+  return n.value<double>();
+}
+
+}  // namespace
 
 TableReader::TableReader(const toml::table& table, std::string path)
     : table_(table), path_(std::move(path)) {}
@@ -30,7 +44,7 @@ Real TableReader::number(const std::string& key, const Range& range) {
   if (!n.is_number()) {
     throw InputError(fmt::format("{}: expected a number ({})", field(key), range.text));
   }
-  const Real v = n.value<double>().value();
+  const Real v = *real_of(n);
   if (!std::isfinite(v)) {
     throw InputError(fmt::format("{} = {} is not allowed: the value must be finite ({})",
                                  field(key), v, range.text));
@@ -100,7 +114,7 @@ Vec3 TableReader::vec3(const std::string& key, Real fill) {
   }
   Vec3 v = Vec3::Constant(fill);
   for (std::size_t i = 0; i < a->size(); ++i) {
-    const auto x = (*a)[i].value<double>();
+    const auto x = real_of((*a)[i]);
     if (!x || !std::isfinite(*x)) {
       throw InputError(fmt::format("{}[{}]: expected a finite number", field(key), i));
     }
@@ -158,7 +172,7 @@ Parameters TableReader::numbers_as_parameters(const std::set<std::string>& skip)
     if (skip.count(key)) continue;
     asked_.insert(key);
     if (!v.is_number()) throw InputError(fmt::format("{}: expected a number", field(key)));
-    values[key] = v.value<double>().value();
+    values[key] = *real_of(v);
   }
   return Parameters(path_, std::move(values));
 }

@@ -280,5 +280,18 @@ TEST(SceneFuzz, EveryInputIsAcceptedOrRejectedWithAMessage) {
   EXPECT_GT(rejected, inputs / 5);
 }
 
+// Found by libFuzzer (scripts/fuzz.sh): an integer beyond 2^53, which a double
+// cannot hold exactly, ended the program (std::bad_optional_access) as a
+// material parameter and as a number field. It is read at the nearest double,
+// as the same number with a decimal point is.
+TEST(SceneFuzz, IntegersBeyondTwoToThe53AreReadAsTheNearestDouble) {
+  const std::string text = testing::free_body_toml(2, "flip", "linear", "");
+  const testing::FuzzVerdict v =
+      testing::check_scene_input(text, {"materials.jelly.E=39647841760435743"});
+  EXPECT_TRUE(v.accepted) << v.message;
+  // A number field (TableReader::number): accepted or refused with a message, never a crash.
+  EXPECT_NO_THROW(testing::check_scene_input(text, {"time.t_end=9007199254740993"}));
+}
+
 }  // namespace scene_fuzz_test
 }  // namespace mpmtb
