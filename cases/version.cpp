@@ -5,12 +5,10 @@
 #include <fmt/format.h>
 
 #include "core/types.hpp"
+#include "git_revision.hpp"  // MPMTB_GIT_REV, written at every build (revision.cmake)
 
 #ifndef MPMTB_VERSION
 #define MPMTB_VERSION "unknown"
-#endif
-#ifndef MPMTB_GIT_REV
-#define MPMTB_GIT_REV "unknown"
 #endif
 #ifndef MPMTB_BUILD_TYPE
 #define MPMTB_BUILD_TYPE "unknown"

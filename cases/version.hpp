@@ -10,7 +10,7 @@ namespace mpmtb {
 
 struct BuildInfo {
   std::string version;       // semantic version, e.g. 0.2.0
-  std::string git_revision;  // short hash at configure time, or "unknown"
+  std::string git_revision;  // short hash built, "-dirty.<diff>" with edits, or "unknown"
   std::string build_type;    // Release, Debug, ...
   std::string compiler;      // id and version, e.g. GNU 12.2.0
   std::string precision;     // the field type: double or float
