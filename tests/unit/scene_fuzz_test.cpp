@@ -13,6 +13,7 @@
 
 #include "support/scene_fuzz.hpp"
 #include "support/scenes.hpp"
+#include "table_reader.hpp"
 
 namespace mpmtb {
 namespace scene_fuzz_test {
@@ -291,6 +292,16 @@ TEST(SceneFuzz, IntegersBeyondTwoToThe53AreReadAsTheNearestDouble) {
   EXPECT_TRUE(v.accepted) << v.message;
   // A number field (TableReader::number): accepted or refused with a message, never a crash.
   EXPECT_NO_THROW(testing::check_scene_input(text, {"time.t_end=9007199254740993"}));
+  // The value read by each numeric reader is the nearest double, which the
+  // compiler's rounding of the same literal with a decimal point gives
+  // independently (2^53 + 1 rounds to 2^53, ties to even).
+  const toml::table table =
+      toml::parse("E = 39647841760435743\nv = [9007199254740993, 2]\nk = -39647841760435743\n");
+  TableReader reader(table, "t");
+  EXPECT_EQ(reader.number("E", Range::any()), static_cast<Real>(39647841760435743.0));
+  EXPECT_EQ(reader.vec3("v")[0], static_cast<Real>(9007199254740992.0));
+  EXPECT_EQ(reader.numbers_as_parameters({"E", "v"}).values().at("k"),
+            static_cast<Real>(-39647841760435743.0));
 }
 
 }  // namespace scene_fuzz_test
