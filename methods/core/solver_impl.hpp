@@ -385,17 +385,17 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
         TensorTransfer<Dim, Kernel>::template scatter_folded<TensorTerms{}>(
             StencilT(P.x[p], this->domain_F(P, p), g.geo), g.geo, form, 0, q_sums_.data());
       });
-      // Unpacked, divided and added to v_old row by row, while the row is in cache.
       for_each_active_row(g, [&](long first, long count) {
         q_sums_.template unpack<true, true>(first, count, q_mass_.data(), q_sum_.data(), nullptr);
-        for (long i = first; i < first + count; ++i) {
-          if (q_mass_[i] > 0) {
-            q_field_[i] = q_sum_[i] / q_mass_[i];
-          } else {
-            q_field_[i].setZero();
-          }
-          g.v_old[i] += c[j] * q_field_[i];
+      });
+      // A pass of its own: fused into the unpack's row loop it measured 0.96x.
+      for_each_active_node(g, [&](long i) {
+        if (q_mass_[i] > 0) {
+          q_field_[i] = q_sum_[i] / q_mass_[i];
+        } else {
+          q_field_[i].setZero();
         }
+        g.v_old[i] += c[j] * q_field_[i];
       });
     }
   }
