@@ -190,6 +190,14 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     // Contiguous shares of the particles, sized by the threads' speeds in the
     // last G2P (core/thread_split.hpp).
     gather_split_.open();
+    // Each thread's share, for the team the region is planned to have (a team
+    // of another size, in a nested region, takes even shares without stealing).
+    const int planned = n >= kParallelMinimum ? omp_get_max_threads() : 1;
+    gather_shares_.open(planned);
+    for (int t = 0; t < planned; ++t) {
+      const auto [from, to] = gather_split_.range(t, planned, n);
+      gather_shares_.set(t, from, to);
+    }
     int threads_used = 1;
 #pragma omp parallel reduction(min                           \
                                : J_min, non_finite, outside) \
@@ -198,56 +206,65 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     {
       const int threads = omp_get_num_threads(), t = omp_get_thread_num();
       if (t == 0) threads_used = threads;
-      const auto [from, to] = gather_split_.range(t, threads, n);
       const double start = omp_get_wtime();
-      long previous = -1;  // this thread's last particle, not yet checked
-      for (long p0 = from; p0 < to; p0 += kRun) {
-        for_each_in_run(
-            P, g.geo, p0, std::min<long>(kRun, to - p0),
-            [&](long p, const StencilT& st) MPMTB_INLINE_LAMBDA {
-              // kDeform = false: the finish may update F, the motion part keeps it.
-              const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
-                if constexpr (kDeform) {
-                  finish_particle();
-                } else {
-                  const Mat<Dim> F = P.F[p];
-                  finish_particle();
-                  P.F[p] = F;
-                }
-              };
-              if constexpr (kFinishRows) {
-                const auto sums =
-                    TensorTransfer<Dim, Kernel>::template gather_rows<Policy::gather_terms>(
-                        st, g.geo, rows_.data());
-                finish([&]() MPMTB_INLINE_LAMBDA {
-                  policy.finish_rows(sums, st, P, static_cast<int>(p), dt);
-                });
-              } else {
-                // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
-                // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
-                typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
-                  if constexpr (kTensorPath) {
-                    return tensor_gather(policy, st, g.geo, rows_.data());
+      long first = 0, last = 0, gathered = 0;
+      bool taken_alone = false;
+      const auto take = [&] {
+        if (threads == planned) return gather_shares_.next(t, threads, kChunk, first, last);
+        first = n * t / threads, last = n * (t + 1) / threads;
+        return !std::exchange(taken_alone, true) && first < last;
+      };
+      while (take()) {
+        gathered += last - first;
+        long previous = -1;  // this thread's last particle, not yet checked
+        for (long p0 = first; p0 < last; p0 += kRun) {
+          for_each_in_run(
+              P, g.geo, p0, std::min<long>(kRun, last - p0),
+              [&](long p, const StencilT& st) MPMTB_INLINE_LAMBDA {
+                // kDeform = false: the finish may update F, the motion part keeps it.
+                const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
+                  if constexpr (kDeform) {
+                    finish_particle();
                   } else {
-                    return begin_gather(policy, st);
+                    const Mat<Dim> F = P.F[p];
+                    finish_particle();
+                    P.F[p] = F;
                   }
-                }();
-                if constexpr (!kTensorPath) {
-                  st.for_each_node(g.geo,
-                                   [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
-                                     policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
-                                   });
+                };
+                if constexpr (kFinishRows) {
+                  const auto sums =
+                      TensorTransfer<Dim, Kernel>::template gather_rows<Policy::gather_terms>(
+                          st, g.geo, rows_.data());
+                  finish([&]() MPMTB_INLINE_LAMBDA {
+                    policy.finish_rows(sums, st, P, static_cast<int>(p), dt);
+                  });
+                } else {
+                  // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
+                  // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
+                  typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
+                    if constexpr (kTensorPath) {
+                      return tensor_gather(policy, st, g.geo, rows_.data());
+                    } else {
+                      return begin_gather(policy, st);
+                    }
+                  }();
+                  if constexpr (!kTensorPath) {
+                    st.for_each_node(
+                        g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
+                          policy.gather(gather, w, grad, d, g.v[node], g.v_old[node]);
+                        });
+                  }
+                  finish([&]() MPMTB_INLINE_LAMBDA {
+                    policy.finish(gather, P, static_cast<int>(p), dt);
+                  });
                 }
-                finish([&]() MPMTB_INLINE_LAMBDA {
-                  policy.finish(gather, P, static_cast<int>(p), dt);
-                });
-              }
-              if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
-              previous = p;
-            });
+                if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
+                previous = p;
+              });
+        }
+        if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
       }
-      if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
-      gather_split_.record(t, to - from, omp_get_wtime() - start);
+      gather_split_.record(t, gathered, omp_get_wtime() - start);
     }
     gather_split_.close(threads_used);
     return {J_min, J_max, std::sqrt(v2_max), non_finite == n ? -1 : non_finite,
@@ -411,7 +428,10 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     }
   }();
   VelocityRows<Dim, kGatherOld> rows_;
-  ThreadSplit gather_split_;  // G2P's shares of the particles per thread
+  ThreadSplit gather_split_;      // G2P's shares of the particles per thread
+  StealingShares gather_shares_;  // taken in chunks of kChunk, the last ones stolen
+  // G2P's chunks: whole runs, few enough that taking one costs nothing.
+  static constexpr long kChunk = 16 * kRun;
   // Scratch of filter_old_velocity: nodal field, sums and masses; particle values.
   std::vector<Vec<Dim>> q_field_, q_sum_, q_particle_;
   std::vector<Real> q_mass_;

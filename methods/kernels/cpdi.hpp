@@ -96,6 +96,8 @@ struct Stencil<Dim, CpdiKernel> {
   static constexpr int S = CpdiKernel::support;
   static constexpr int count = ipow(S, Dim);
   static constexpr int corners = 1 << Dim;
+  // Nodes the box may reach from first_index: it starts there or one node later.
+  static constexpr int kSpan = S + 1;
 
   long base_node = 0;  // linear index of the box's first node
   Real w_[count];

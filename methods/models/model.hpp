@@ -14,6 +14,7 @@
 
 #include "core/batch_log.hpp"
 #include "core/particles.hpp"
+#include "core/thread_split.hpp"
 #include "core/types.hpp"
 
 namespace mpmtb {
@@ -172,6 +173,9 @@ class ModelBase : public ConstitutiveModel<Dim> {
  private:
   // Particles per batch of logarithms (core/batch_log.hpp).
   static constexpr int kLogBatch = 64;
+  // Batches a thread takes at a time in for_each_chunk_balanced (256 particles:
+  // 64 chunks per thread for the 32,768 particles of the 3D block at 2 threads).
+  static constexpr long kLogChunk = 4;
   // f(p, ln det F_p) for every particle p of ids, in parallel over batches of
   // kLogBatch: each batch's logarithms first, in vector registers
   // (core/batch_log.hpp), then f for its particles. For the models whose stress
@@ -180,15 +184,16 @@ class ModelBase : public ConstitutiveModel<Dim> {
   static void for_each_with_log(const Particles<Dim>& particles, std::span<const int> ids, F&& f) {
     const long n = static_cast<long>(ids.size());
     const long batches = (n + kLogBatch - 1) / kLogBatch;
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-    for (long b = 0; b < batches; ++b) {
-      const long first = b * kLogBatch;
-      const int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
-      Real J[kLogBatch], logJ[kLogBatch];
-      for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
-      batch_log(J, logJ, count);
-      for (int k = 0; k < count; ++k) f(ids[first + k], logJ[k]);
-    }
+    for_each_chunk_balanced(batches, kLogChunk, n >= kParallelMinimum, [&](long from, long to) {
+      for (long b = from; b < to; ++b) {
+        const long first = b * kLogBatch;
+        const int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
+        Real J[kLogBatch], logJ[kLogBatch];
+        for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
+        batch_log(J, logJ, count);
+        for (int k = 0; k < count; ++k) f(ids[first + k], logJ[k]);
+      }
+    });
   }
   const Derived& self() const {
     return static_cast<const Derived&>(*this);

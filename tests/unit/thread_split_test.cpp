@@ -1,8 +1,12 @@
 // ThreadSplit (core/thread_split.hpp): contiguous shares of a loop's items,
-// even until measured, then in proportion to the threads' measured speeds.
+// even until measured, then in proportion to the threads' measured speeds; and
+// StealingShares: the shares taken in chunks, the last ones by other threads.
 #include <gtest/gtest.h>
 
+#include <omp.h>
+#include <atomic>
 #include <cmath>
+#include <vector>
 
 #include "core/thread_split.hpp"
 
@@ -85,6 +89,63 @@ TEST(ThreadSplit, KeepsItsSharesWithoutAMeasurementAndResetsForAnotherThreadCoun
   // Shares measured with 2 threads say nothing about 3: even again.
   EXPECT_EQ(split.cut(1, 3, 1200), 400);
   EXPECT_EQ(split.cut(2, 3, 1200), 800);
+}
+
+// Serially, thread by thread: a thread takes its own share from the front in
+// chunks, then the back of the fullest other share; every item exactly once.
+TEST(StealingShares, OwnShareFromTheFrontThenOthersFromTheBack) {
+  StealingShares shares;
+  shares.open(3);
+  shares.set(0, 0, 10), shares.set(1, 10, 30), shares.set(2, 30, 35);
+  std::vector<int> taken(35, 0);
+  long first = 0, last = 0;
+  // Thread 0: its own 10 in chunks of 4 (4, 4, 2) from the front.
+  for (const long expected : {0L, 4L, 8L}) {
+    ASSERT_TRUE(shares.next(0, 3, 4, first, last));
+    EXPECT_EQ(first, expected);
+    EXPECT_EQ(last, std::min(expected + 4, 10L));
+    for (long i = first; i < last; ++i) ++taken[i];
+  }
+  // Then the back of thread 1's share (20 left, against thread 2's 5).
+  ASSERT_TRUE(shares.next(0, 3, 4, first, last));
+  EXPECT_EQ(first, 26);
+  EXPECT_EQ(last, 30);
+  for (long i = first; i < last; ++i) ++taken[i];
+  // Threads 1 and 2 go on from their fronts; all three drain what is left.
+  for (int t : {1, 2, 0, 1, 2}) {
+    while (shares.next(t, 3, 3, first, last)) {
+      EXPECT_LT(first, last);
+      for (long i = first; i < last; ++i) ++taken[i];
+    }
+  }
+  for (int i = 0; i < 35; ++i) EXPECT_EQ(taken[i], 1) << "item " << i;
+  EXPECT_FALSE(shares.next(2, 3, 3, first, last));
+}
+
+// In a parallel region, one thread held up at its first chunk: the loop still
+// covers every item exactly once (which thread took what is the schedule's
+// business; no item is lost or repeated).
+TEST(StealingShares, ParallelLoopCoversEveryItemOnce) {
+  const long n = 10007;
+  for (const int threads : {1, 2, 3, 4}) {
+    std::vector<std::atomic<int>> hits(n);
+    omp_set_num_threads(threads);
+    std::atomic<bool> held{true};
+    for_each_chunk_balanced(n, 16, true, [&](long first, long last) {
+      // Thread 0 spins on its first chunk until another thread has gone through
+      // its own share and come to take from the others (or alone: at once).
+      if (omp_get_thread_num() == 0 && first == 0) {
+        while (held.load() && omp_get_num_threads() == threads && threads > 1) {
+        }
+      }
+      if (omp_get_thread_num() != 0 && last > n * (omp_get_thread_num() + 1) / threads)
+        held = false;
+      if (omp_get_thread_num() != 0 && first < n * omp_get_thread_num() / threads) held = false;
+      for (long i = first; i < last; ++i) hits[i].fetch_add(1);
+    });
+    for (long i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << threads << " threads, item " << i;
+  }
+  omp_set_num_threads(omp_get_num_procs());
 }
 
 }  // namespace
