@@ -127,6 +127,7 @@ TEST(StealingShares, OwnShareFromTheFrontThenOthersFromTheBack) {
 // business; no item is lost or repeated).
 TEST(StealingShares, ParallelLoopCoversEveryItemOnce) {
   const long n = 10007;
+  const int threads_before = omp_get_max_threads();
   for (const int threads : {1, 2, 3, 4}) {
     std::vector<std::atomic<int>> hits(n);
     omp_set_num_threads(threads);
@@ -145,7 +146,7 @@ TEST(StealingShares, ParallelLoopCoversEveryItemOnce) {
     });
     for (long i = 0; i < n; ++i) ASSERT_EQ(hits[i].load(), 1) << threads << " threads, item " << i;
   }
-  omp_set_num_threads(omp_get_num_procs());
+  omp_set_num_threads(threads_before);  // as the other tests of this process expect
 }
 
 }  // namespace
