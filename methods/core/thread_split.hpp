@@ -149,9 +149,10 @@ class StealingShares {
 // each thread starts on an even share, then takes from the others' backs
 // (StealingShares). For loops whose items are independent and cheap enough
 // that no speeds are kept for them (the stress pass: on the 3D block at 2
-// threads, an even static split left a thread waiting there for 5 % of the run). The shares are set before the region,
-// for the team it is planned to have: no barrier is needed before the first
-// take. A team of another size (nested regions) splits evenly, without stealing.
+// threads, an even static split left a thread waiting there for 5 % of the
+// run). The shares are set before the region, for the team it is planned to
+// have: no barrier is needed before the first take. A team of another size
+// (nested regions) splits evenly, without stealing.
 template <class F>
 void for_each_chunk_balanced(long n, long chunk, bool parallel, F&& f) {
   const int planned = parallel ? omp_get_max_threads() : 1;
