@@ -23,6 +23,15 @@ Real fixed_corotated_psi(const Mat<Dim>& F, Real mu, Real lambda) {
   return mu * (F - polar_rotation<Dim>(F)).squaredNorm() + Real(0.5) * lambda * (J - 1) * (J - 1);
 }
 
+// psi from the signed singular values sigma of F (polar.hpp): mu |F - R|^2 =
+// mu sum_i (sigma_i - 1)^2 and J = prod_i sigma_i (the header's second form),
+// for a caller that has the SVD already (the snow return map).
+template <int Dim>
+Real fixed_corotated_psi_of_sigma(const Vec<Dim>& sigma, Real mu, Real lambda) {
+  const Real J = sigma.prod();
+  return mu * (sigma.array() - 1).square().sum() + Real(0.5) * lambda * (J - 1) * (J - 1);
+}
+
 template <int Dim>
 Mat<Dim> fixed_corotated_P(const Mat<Dim>& F, Real mu, Real lambda) {
   const Real J = F.determinant();
@@ -30,7 +39,7 @@ Mat<Dim> fixed_corotated_P(const Mat<Dim>& F, Real mu, Real lambda) {
 }
 
 template <int Dim>
-Mat<Dim> fixed_corotated_tau(const Mat<Dim>& F, Real mu, Real lambda) {
+MPMTB_INLINE inline Mat<Dim> fixed_corotated_tau(const Mat<Dim>& F, Real mu, Real lambda) {
   const Real J = F.determinant();
   return 2 * mu * (F - polar_rotation<Dim>(F)) * F.transpose() +
          lambda * (J - 1) * J * Mat<Dim>::Identity();

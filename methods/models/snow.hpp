@@ -101,6 +101,9 @@ class Snow final : public ModelBase<Dim, Snow<Dim>> {
   Real psi(const Mat<Dim>& F, const Real* q) const {
     return hardening(q[kJP]) * fixed_corotated_psi<Dim>(F, c_.mu, c_.lambda);
   }
+  Real psi_of_sigma(const Vec<Dim>& sigma, const Real* q) const {
+    return hardening(q[kJP]) * fixed_corotated_psi_of_sigma<Dim>(sigma, c_.mu, c_.lambda);
+  }
   Mat<Dim> P(const Mat<Dim>& F, const Real* q) const {
     return hardening(q[kJP]) * fixed_corotated_P<Dim>(F, c_.mu, c_.lambda);
   }
@@ -128,11 +131,13 @@ class Snow final : public ModelBase<Dim, Snow<Dim>> {
     }
     const SignedSvd<Dim> svd = signed_svd<Dim>(F);
     if (Dim != 2 && elastic(svd.sigma)) return;
-    const Real psi_trial = psi(F, q);
+    // The energies before and after from the singular values (psi's second
+    // form, fixed_corotated.hpp): no polar decomposition of either F.
+    const Real psi_trial = psi_of_sigma(svd.sigma, q);
     const Vec<Dim> clamped = svd.sigma.cwiseMax(lo).cwiseMin(hi);
     F = svd.U * clamped.asDiagonal() * svd.V.transpose();
     q[kJP] *= svd.sigma.prod() / clamped.prod();
-    q[kDissipated] += psi_trial - psi(F, q);
+    q[kDissipated] += psi_trial - psi_of_sigma(clamped, q);
   }
   Real dissipated(const Real* q) const { return q[kDissipated]; }
 

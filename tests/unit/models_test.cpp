@@ -340,5 +340,27 @@ TEST(FixedCorotatedModel, DefinedForInvertedAndDegenerateF) {
   EXPECT_LT((P0.array() * cofactor<3>(flat).array()).sum(), 0);
 }
 
+// psi's two forms (fixed_corotated.hpp): mu |F - R|^2 + lambda/2 (J - 1)^2 with
+// R from the polar decomposition, and mu sum (sigma_i - 1)^2 + lambda/2
+// (prod sigma_i - 1)^2 from the signed singular values (the snow return map's).
+// They agree to round-off, for inverted F too (sigma_d < 0).
+template <int Dim>
+void ExpectPsiFormsAgree() {
+  std::mt19937 gen(7 + Dim);
+  const Real mu = 40, lambda = 60;
+  Mat<Dim> reflect = Mat<Dim>::Identity();
+  reflect(Dim - 1, Dim - 1) = -1;
+  for (int s = 0; s < 40; ++s) {
+    const Mat<Dim> F = s % 2 ? Mat<Dim>(RandomF<Dim>(gen, 0.5) * reflect) : RandomF<Dim>(gen, 0.5);
+    const Real by_polar = fixed_corotated_psi<Dim>(F, mu, lambda);
+    const Real by_sigma = fixed_corotated_psi_of_sigma<Dim>(signed_svd<Dim>(F).sigma, mu, lambda);
+    EXPECT_NEAR(by_sigma, by_polar, 1e-12 * (1 + std::abs(by_polar))) << "F =\n" << F;
+  }
+}
+TEST(FixedCorotatedModel, EnergyOfSingularValuesIsTheEnergyOfF) {
+  ExpectPsiFormsAgree<2>();
+  ExpectPsiFormsAgree<3>();
+}
+
 }  // namespace models_test
 }  // namespace mpmtb
