@@ -7,6 +7,7 @@
 #include <algorithm>
 #include <array>
 #include <limits>
+#include <span>
 #include <vector>
 
 #include "core/state.hpp"
@@ -175,6 +176,19 @@ class ParticleBlocks {
   // every colour and step, so that the particles a thread scatters are mostly
   // those it gathers (G2P splits the particles in index order, which follows
   // space: the lattice order of the setup) and stay in its core's caches.
+  // f(colour, ids) for every block of the last bin(), colour by colour: the
+  // particle ids of the block, in the order the scatter takes them (tests).
+  template <class F>
+  void for_each_block(F&& f) const {
+    const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
+    for (int colour = 0; colour < kColours; ++colour) {
+      for (int k = colour * per_colour; k < (colour + 1) * per_colour; ++k) {
+        f(colour, std::span<const int>(block_order_.data() + block_start_[k],
+                                       block_order_.data() + block_start_[k + 1]));
+      }
+    }
+  }
+
   template <class Scatter>
   void for_each_coloured(const State<Dim>& s, Scatter&& scatter) const {
     const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
