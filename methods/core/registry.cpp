@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include "core/combinations.hpp"
 #include "core/errors.hpp"
 #include "core/solver.hpp"
 #include "kernels/all.hpp"
@@ -72,17 +73,39 @@ std::string unsupported_reason(std::string_view transfer, std::string_view kerne
   return reason;
 }
 
+bool compiled_combination(std::string_view transfer, std::string_view kernel) {
+  require_known(transfer, kernel);
+  bool compiled = false;
+  AllTransfers::for_each([&]<class T>() {
+    AllKernels::for_each([&]<class K>() {
+      compiled |= kCompiled<T, K> && T::name == transfer && K::name == kernel;
+    });
+  });
+  return compiled;
+}
+
 template <int Dim>
 std::unique_ptr<Stepper<Dim>> make_stepper(std::string_view transfer, std::string_view kernel,
                                            Parameters& transfer_params) {
   if (auto reason = unsupported_reason(transfer, kernel); !reason.empty()) {
     throw InputError(reason);
   }
+  if (!compiled_combination(transfer, kernel)) {
+    std::string compiled;
+    for (const auto& k : kernel_list()) {
+      if (compiled_combination(transfer, k.name))
+        compiled += (compiled.empty() ? "" : ", ") + k.name;
+    }
+    throw InputError(
+        fmt::format("method.kernel: transfer '{}' with kernel '{}' is not compiled in this build "
+                    "(MPMTB_COMBINATIONS=reduced); kernels compiled for '{}': {}",
+                    transfer, kernel, transfer, compiled));
+  }
   std::unique_ptr<Stepper<Dim>> stepper;
   AllTransfers::for_each([&]<class T>() {
     if (T::name != transfer) return;
     AllKernels::for_each([&]<class K>() {
-      if constexpr (T::template supports<K>) {
+      if constexpr (kCompiled<T, K>) {
         if (K::name == kernel) stepper = make_solver<Dim, K, T>(transfer_params);
       }
     });

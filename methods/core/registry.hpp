@@ -30,8 +30,14 @@ std::vector<VariantInfo> kernel_list();
 // Unknown names throw InputError listing the valid ones.
 std::string unsupported_reason(std::string_view transfer, std::string_view kernel);
 
+// True when the solvers of the combination are compiled in this build: every
+// supported one by default, a subset with MPMTB_COMBINATIONS=reduced (the
+// sanitizer tree; core/combinations.hpp). Unknown names throw InputError.
+bool compiled_combination(std::string_view transfer, std::string_view kernel);
+
 // The compiled solver for (Dim, kernel, transfer). Throws InputError for
-// unknown names (listing the valid ones) and refused combinations.
+// unknown names (listing the valid ones), refused combinations and, in a
+// reduced build, combinations not compiled (naming the kernels that are).
 template <int Dim>
 std::unique_ptr<Stepper<Dim>> make_stepper(std::string_view transfer, std::string_view kernel,
                                            Parameters& transfer_params);

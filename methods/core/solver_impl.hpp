@@ -12,6 +12,7 @@
 #include <type_traits>
 #include <utility>
 
+#include "core/combinations.hpp"
 #include "core/policy_hooks.hpp"
 #include "core/solver.hpp"
 #include "core/solver_stages.hpp"
@@ -452,7 +453,7 @@ std::unique_ptr<Stepper<Dim>> make_solver(Parameters& transfer_params) {
 template <class Transfer>
 void SolverInstances<Transfer>::instantiate() {
   AllKernels::for_each([]<class K>() {
-    if constexpr (Transfer::template supports<K>) {
+    if constexpr (kCompiled<Transfer, K>) {
       [[maybe_unused]] volatile auto f1 = &make_solver<1, K, Transfer>;
       [[maybe_unused]] volatile auto f2 = &make_solver<2, K, Transfer>;
       [[maybe_unused]] volatile auto f3 = &make_solver<3, K, Transfer>;

@@ -1,0 +1,49 @@
+// Which transfer x kernel combinations this build compiles: the CMake option
+// MPMTB_COMBINATIONS (all, the default, or reduced, which defines
+// MPMTB_REDUCED_COMBINATIONS). SolverInstances (core/solver_impl.hpp) compiles
+// the solvers of these combinations, for every dimension; the registry
+// (core/registry.cpp) resolves names only to them and refuses the others.
+#pragma once
+
+#include <type_traits>
+
+#include "kernels/all.hpp"
+#include "transfers/all.hpp"
+
+namespace mpmtb {
+
+#ifdef MPMTB_REDUCED_COMBINATIONS
+inline constexpr bool kReducedCombinations = true;
+#else
+inline constexpr bool kReducedCombinations = false;
+#endif
+
+// The reduced set is for the sanitizer tree (scripts/sanitize.sh), where
+// compiling the solvers dominates the stage: every code path once, not every
+// product of them.
+// * Every transfer with the quadratic B-spline (which all of them support):
+//   each transfer's own math runs.
+// * Every kernel with two transfers, one of each scatter form of the solver
+//   (folds_force, core/solver_impl.hpp): FLIP keeps v_old, so its force is
+//   scattered apart from the momentum; MLS-MPM folds the force into the
+//   momentum and, being affine, runs the kernel's own branch of D_p
+//   (transfers/affine.hpp: constant for the B-splines, the gradient form for
+//   the hat, per particle for uGIMP and cpGIMP). CPDI refuses the affine
+//   transfers (full D_p), so PIC folds for it.
+// The transfer-independent stages are compiled for every kernel with both
+// scatter forms anyway (core/solver_stages_*d.cpp); this set runs both.
+template <class Kernel>
+using FoldingPartner =
+    std::conditional_t<MlsTransfer::template supports<Kernel>, MlsTransfer, PicTransfer>;
+template <class Transfer, class Kernel>
+inline constexpr bool kReducedSet =
+    std::is_same_v<Kernel, QuadraticKernel> || std::is_same_v<Transfer, FlipTransfer> ||
+    std::is_same_v<Transfer, FoldingPartner<Kernel>>;
+
+// True when the solvers of (Transfer, Kernel) are compiled in this build: in
+// the default build every combination the transfer supports.
+template <class Transfer, class Kernel>
+inline constexpr bool kCompiled = Transfer::template supports<Kernel> &&
+                                  (!kReducedCombinations || kReducedSet<Transfer, Kernel>);
+
+}  // namespace mpmtb
