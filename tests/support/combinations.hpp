@@ -1,5 +1,7 @@
 // Every compiled (dimension, transfer, kernel): new variants join the
-// parameterized tests automatically.
+// parameterized tests automatically. A reduced build (MPMTB_COMBINATIONS=reduced,
+// the sanitizer tree; methods/core/combinations.hpp) lists only the combinations
+// it compiles (tests that name another one skip: support/compiled.hpp).
 #pragma once
 
 #include <gtest/gtest.h>
@@ -31,7 +33,8 @@ inline std::vector<Combination> all_combinations(std::vector<int> dims = {1, 2, 
       if (which == Transfers::conserving_angular_momentum && !t.conserves_angular_momentum)
         continue;
       for (const auto& k : kernel_list()) {
-        if (unsupported_reason(t.name, k.name).empty()) out.push_back({dim, t.name, k.name});
+        if (unsupported_reason(t.name, k.name).empty() && compiled_combination(t.name, k.name))
+          out.push_back({dim, t.name, k.name});
       }
     }
   }

@@ -11,6 +11,7 @@
 #include "core/errors.hpp"
 #include "core/registry.hpp"
 #include "setup.hpp"
+#include "support/compiled.hpp"
 #include "support/gaps.hpp"
 #include "support/scenes.hpp"
 
@@ -94,6 +95,7 @@ TEST(Asflip, BetaFollowsTheSeparationCriterion) {
 // parabola. The criterion's mixed beta breaks that: with the linear hat some
 // particles read as compressed (log J < -1e-3) and the centre of mass drifts.
 TEST(Asflip, CentreOfMassFollowsMomentumOnlyForUniformBeta) {
+  MPMTB_SKIP_UNLESS_COMPILED("asflip", "linear");
   auto drift = [](const std::vector<std::string>& set) {
     const Scene scene = testing::scene_from_toml(
         testing::free_body_toml(2, "asflip", "linear", "[physics]\ngravity = [-3.0, -9.81, 0.0]\n"),

@@ -11,6 +11,8 @@
 #include <sstream>
 #include <string>
 
+#include "core/combinations.hpp"
+#include "core/errors.hpp"
 #include "core/registry.hpp"
 #include "kernels/all.hpp"
 #include "models/registry.hpp"
@@ -73,8 +75,10 @@ std::set<std::string> registered_tests() {
   return names;
 }
 
-// Every supported (dimension, transfer, kernel) has its conformance tests; the
+// Every compiled (dimension, transfer, kernel) has its conformance tests; the
 // transfers that claim angular momentum conservation also have those checks.
+// A combination this build does not compile (MPMTB_COMBINATIONS=reduced) has
+// none: the generator leaves it out rather than letting it fail.
 TEST(Registry, EveryCombinationJoinsTheConformanceTests) {
   const auto tests = registered_tests();
   int combinations = 0;
@@ -82,21 +86,106 @@ TEST(Registry, EveryCombinationJoinsTheConformanceTests) {
     for (const auto& t : transfer_list()) {
       for (const auto& k : kernel_list()) {
         if (!unsupported_reason(t.name, k.name).empty()) continue;
-        ++combinations;
+        const bool compiled = compiled_combination(t.name, k.name);
+        combinations += compiled;
         const std::string id = std::to_string(dim) + "d_" + t.name + "_" + k.name;
         for (const char* test : {"AllCombinations/TransferTest.G2PConservesMomentum/",
                                  "AllCombinations/StepTest.P2GConservesMass/",
                                  "AllCombinations/StepTest.FreeFlightConservesMomentum/"})
-          EXPECT_TRUE(tests.count(test + id)) << test << id;
+          EXPECT_EQ(tests.count(test + id) > 0, compiled) << test << id;
         if (t.conserves_angular_momentum && dim >= 2) {
           const std::string test = "AffineCombinations/AffineTransferTest.";
-          EXPECT_TRUE(tests.count(test + "AngularMomentumConservedBothWays/" + id)) << id;
-          EXPECT_TRUE(tests.count(test + "AffineFieldRoundTripIsExact/" + id)) << id;
+          EXPECT_EQ(tests.count(test + "AngularMomentumConservedBothWays/" + id) > 0, compiled)
+              << id;
+          EXPECT_EQ(tests.count(test + "AffineFieldRoundTripIsExact/" + id) > 0, compiled) << id;
         }
       }
     }
   }
   EXPECT_GE(combinations, 3 * static_cast<int>(transfer_list().size()));
+}
+
+// The query the registry answers is the predicate the solvers are compiled by
+// (core/combinations.hpp), and the set keeps what it promises: every transfer
+// runs (with the quadratic B-spline), and every kernel runs with a transfer that
+// keeps v_old (its force scattered apart) and one that does not. The default
+// build compiles every supported combination, a reduced one fewer.
+TEST(Registry, CompiledCombinationsCoverEveryTransferAndKernel) {
+  int supported = 0, compiled = 0;
+  AllTransfers::for_each([&]<class T>() {
+    AllKernels::for_each([&]<class K>() {
+      EXPECT_EQ(compiled_combination(T::name, K::name), (kCompiled<T, K>))
+          << T::name << " " << K::name;
+      supported += T::template supports<K>;
+      compiled += kCompiled<T, K>;
+    });
+    EXPECT_TRUE((kCompiled<T, QuadraticKernel>)) << T::name;
+  });
+  AllKernels::for_each([&]<class K>() {
+    bool keeps_v_old = false, does_not = false;
+    AllTransfers::for_each([&]<class T>() {
+      if constexpr (kCompiled<T, K>) (T::needs_old_velocity ? keeps_v_old : does_not) = true;
+    });
+    EXPECT_TRUE(keeps_v_old) << K::name << ": no compiled transfer keeps v_old";
+    EXPECT_TRUE(does_not) << K::name << ": every compiled transfer keeps v_old";
+  });
+  if (kReducedCombinations) {
+    EXPECT_LT(compiled, supported);
+  } else {
+    EXPECT_EQ(compiled, supported);
+  }
+}
+
+// make_stepper resolves every compiled combination, in every dimension.
+TEST(Registry, EveryCompiledCombinationMakesAStepper) {
+  int made = 0;
+  for (const auto& t : transfer_list()) {
+    for (const auto& k : kernel_list()) {
+      if (!unsupported_reason(t.name, k.name).empty() || !compiled_combination(t.name, k.name))
+        continue;
+      Parameters p1(t.name), p2(t.name), p3(t.name);
+      EXPECT_NE(make_stepper<1>(t.name, k.name, p1), nullptr) << t.name << " " << k.name;
+      EXPECT_NE(make_stepper<2>(t.name, k.name, p2), nullptr) << t.name << " " << k.name;
+      EXPECT_NE(make_stepper<3>(t.name, k.name, p3), nullptr) << t.name << " " << k.name;
+      ++made;
+    }
+  }
+  EXPECT_GE(made, static_cast<int>(transfer_list().size()));
+}
+
+// In a reduced build a supported combination that is not compiled is an input
+// error that names the field, the build option and the kernels that are
+// compiled for the transfer, not a null stepper or a link error.
+TEST(Registry, UncompiledCombinationIsRefusedWithTheCompiledKernels) {
+  if (!kReducedCombinations) GTEST_SKIP() << "every supported combination is compiled";
+  std::string transfer, kernel;
+  for (const auto& t : transfer_list()) {
+    for (const auto& k : kernel_list()) {
+      if (transfer.empty() && unsupported_reason(t.name, k.name).empty() &&
+          !compiled_combination(t.name, k.name)) {
+        transfer = t.name;
+        kernel = k.name;
+      }
+    }
+  }
+  ASSERT_FALSE(transfer.empty()) << "a reduced build compiles every supported combination";
+  std::string compiled;
+  for (const auto& k : kernel_list()) {
+    if (compiled_combination(transfer, k.name)) compiled += (compiled.empty() ? "" : ", ") + k.name;
+  }
+  ASSERT_FALSE(compiled.empty());
+  Parameters params(transfer);
+  try {
+    make_stepper<2>(transfer, kernel, params);
+    ADD_FAILURE() << transfer << " with " << kernel << " was made";
+  } catch (const InputError& e) {
+    const std::string what = e.what();
+    for (const std::string& part :
+         {std::string("method.kernel"), "'" + transfer + "'", "'" + kernel + "'",
+          std::string("not compiled in this build (MPMTB_COMBINATIONS=reduced)"),
+          "kernels compiled for '" + transfer + "': " + compiled})
+      EXPECT_NE(what.find(part), std::string::npos) << part << " not in: " << what;
+  }
 }
 
 // Every kernel is one instance of the typed kernel tests (KernelTest/0, /1, ...).

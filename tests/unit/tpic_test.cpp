@@ -5,6 +5,7 @@
 #include "core/diagnostics.hpp"
 #include "core/registry.hpp"
 #include "setup.hpp"
+#include "support/compiled.hpp"
 #include "support/scenes.hpp"
 
 namespace mpmtb {
@@ -31,6 +32,8 @@ struct SpinRun {
 // TPIC is the same scheme, bit for bit. With the quadratic B-spline the gradient
 // differs from B_p D_p^-1, and so do the trajectories.
 TEST(Tpic, WithTheLinearHatIsApicBitForBit) {
+  MPMTB_SKIP_UNLESS_COMPILED("tpic", "linear");
+  MPMTB_SKIP_UNLESS_COMPILED("apic", "linear");
   auto positions = []<int Dim>(const char* transfer, const char* kernel) {
     SpinRun<Dim> r(transfer, kernel);
     r.steps(50);

@@ -8,6 +8,7 @@
 #include "core/errors.hpp"
 #include "setup.hpp"
 #include "support/combinations.hpp"
+#include "support/compiled.hpp"
 #include "support/gaps.hpp"
 #include "support/scenes.hpp"
 
@@ -178,6 +179,7 @@ TEST(TransferIdentities, FlipWithAlphaZeroIsPic) {
 }
 
 TEST(TransferIdentities, MlsWithTheLinearHatIsApic) {
+  MPMTB_SKIP_UNLESS_COMPILED("apic", "linear");
   EXPECT_EQ(positions_after<3>("mls", "linear"), positions_after<3>("apic", "linear"));
   EXPECT_NE(positions_after<3>("mls", "quadratic"), positions_after<3>("apic", "quadratic"));
 }
