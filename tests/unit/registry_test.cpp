@@ -17,6 +17,7 @@
 #include "kernels/all.hpp"
 #include "models/registry.hpp"
 #include "support/combinations.hpp"
+#include "transfers/all.hpp"
 
 namespace mpmtb {
 namespace registry_test {
