@@ -91,15 +91,13 @@ std::unique_ptr<Stepper<Dim>> make_stepper(std::string_view transfer, std::strin
     throw InputError(reason);
   }
   if (!compiled_combination(transfer, kernel)) {
-    std::string compiled;
-    for (const auto& k : kernel_list()) {
-      if (compiled_combination(transfer, k.name))
-        compiled += (compiled.empty() ? "" : ", ") + k.name;
-    }
+    std::vector<VariantInfo> compiled = kernel_list();
+    std::erase_if(compiled,
+                  [&](const VariantInfo& k) { return !compiled_combination(transfer, k.name); });
     throw InputError(
         fmt::format("method.kernel: transfer '{}' with kernel '{}' is not compiled in this build "
                     "(MPMTB_COMBINATIONS=reduced); kernels compiled for '{}': {}",
-                    transfer, kernel, transfer, compiled));
+                    transfer, kernel, transfer, joined_names(compiled)));
   }
   std::unique_ptr<Stepper<Dim>> stepper;
   AllTransfers::for_each([&]<class T>() {
