@@ -60,10 +60,25 @@
 // colours as P2G does (core/particle_blocks.hpp; the summation order, and so
 // the result, does not depend on the thread count), and the grid passes sweep
 // only the box of nodes the particles reach.
+// The isotropic operator is local, and its exact zeros are kept exact: where no
+// particle with q_p != 0 reaches a node (outside the box `source` of the nodes
+// such particles reach), q_i = +0; lap_i = +0 at a node whose neighbours and
+// itself are all such nodes (outside `source` grown by one node); and lap_p =
+// +0 for a particle whose stencil reaches no node of that grown box. So only
+// the particles whose stencils reach `source` grown by two nodes are
+// transferred (those nodes' masses decide the mirror condition of the nodes
+// within one), lap_i is formed within one node of `source`, and interpolated to
+// the particles that reach it; every other particle takes +0, the bits the
+// whole operator gives it (tests/unit/nonlocal_test.cpp compares the two). A
+// field zero everywhere (the damage before the first crack) costs one sweep
+// over the particles. The anisotropic path's diagonal is nonzero everywhere:
+// it always runs whole.
 #pragma once
 
 #include <algorithm>
 #include <array>
+#include <cstdint>
+#include <limits>
 #include <vector>
 
 #include "core/particle_blocks.hpp"
@@ -89,15 +104,30 @@ class NonlocalLaplacian {
 
   void apply(State<Dim>& s) {
     if (!read_requests(s)) return;
+    const auto& geo = s.grid.geo;
+    NodeBox<Dim> transfer = everywhere(), laplacian = everywhere();
+    if (!aniso_ && localised_) {
+      const NodeBox<Dim> source = source_nodes(s);
+      if (source.nodes() == 0) {  // q_p = 0 everywhere: lap_p = +0 everywhere
+        reach_.assign(s.particles.size(), 0);
+        interpolate_back(s);
+        return;
+      }
+      transfer = grown(source, 2), laplacian = grown(source, 1);
+    }
+    mark_reach(s, transfer, laplacian);
     rebin(s);
-    transfer_to_grid(s);
+    transfer_to_grid(s, intersection(box_, transfer));
     if (aniso_) {
-      grid_divergence(s.grid.geo);
+      grid_divergence(geo);
     } else {
-      grid_laplacian(s.grid.geo);
+      grid_laplacian(geo, intersection(box_, laplacian));
     }
     interpolate_back(s);
   }
+  // Off: the isotropic operator runs over every particle (the reference that
+  // the tests compare the local operator with).
+  void localise(bool on) { localised_ = on; }
 
  private:
   static constexpr int kComponents = Dim * (Dim + 1) / 2;
@@ -158,10 +188,100 @@ class NonlocalLaplacian {
   bool requested(const Particles<Dim>& P, std::size_t p) const {
     return requests_[P.material[p]].active();
   }
-  int width() const { return aniso_ ? kAnisoWidth : kIsoWidth; }
-  Real m(long i) const { return records_[i * width() + kM]; }
-  Real q(long i) const { return records_[i * width() + kQ]; }
-  Real A(int c, long i) const { return records_[i * width() + kA + c]; }
+
+  // Node boxes: every node, grown by k nodes per side, and the common part.
+  static NodeBox<Dim> everywhere() {
+    NodeBox<Dim> b;
+    b.lo.fill(std::numeric_limits<int>::min() / 2), b.hi.fill(std::numeric_limits<int>::max() / 2);
+    return b;
+  }
+  static NodeBox<Dim> grown(NodeBox<Dim> b, int k) {
+    for (int a = 0; a < Dim; ++a) b.lo[a] -= k, b.hi[a] += k;
+    return b;
+  }
+  static NodeBox<Dim> intersection(NodeBox<Dim> b, const NodeBox<Dim>& c) {
+    for (int a = 0; a < Dim; ++a)
+      b.lo[a] = std::max(b.lo[a], c.lo[a]), b.hi[a] = std::min(b.hi[a], c.hi[a]);
+    return b;
+  }
+  static constexpr int kSpan = stencil_span<Dim, Kernel>();
+
+  // The nodes that the requesting particles with q_p != 0 (or NaN) reach; empty
+  // when there are none. Min and max are exact: the box does not depend on the
+  // thread count.
+  NodeBox<Dim> source_nodes(const State<Dim>& s) const {
+    const auto& P = s.particles;
+    const FirstNodes<Dim, Kernel> first_nodes(s.grid.geo);
+    const long n = static_cast<long>(P.size());
+    AxisInts lo = AxisInts{} + std::numeric_limits<int>::max();
+    AxisInts hi = AxisInts{} + std::numeric_limits<int>::min();
+#pragma omp parallel if (n >= kParallelMinimum)
+    {
+      AxisInts lo_t = lo, hi_t = hi;
+#pragma omp for schedule(static) nowait
+      for (long p = 0; p < n; ++p) {
+        if (!requested(P, p) || P.state_of(p)[requests_[P.material[p]].source] == 0) continue;
+        const AxisInts f = first_nodes(P.x[p]);
+        lo_t = f < lo_t ? f : lo_t;
+        hi_t = hi_t < f ? f : hi_t;
+      }
+#pragma omp critical(mpmtb_nonlocal_source)
+      {
+        lo = lo_t < lo ? lo_t : lo;
+        hi = hi < hi_t ? hi_t : hi;
+      }
+    }
+    NodeBox<Dim> box;
+    for (int a = 0; a < Dim; ++a) {
+      box.lo[a] = lo[a];
+      box.hi[a] = hi[a] == std::numeric_limits<int>::min() ? lo[a] - 1 : hi[a] + kSpan - 1;
+    }
+    return box;
+  }
+
+  // reach_[p]: kTransfer when particle p is requested and its stencil reaches a
+  // node of `transfer`, kInterpolate when one of `laplacian` (inside transfer).
+  enum Reach : std::uint8_t { kTransfer = 1, kInterpolate = 2 };
+  void mark_reach(const State<Dim>& s, const NodeBox<Dim>& transfer,
+                  const NodeBox<Dim>& laplacian) {
+    const auto& P = s.particles;
+    const long n = static_cast<long>(P.size());
+    reach_.resize(n);
+    const bool all = transfer.lo == everywhere().lo && laplacian.lo == everywhere().lo;
+    const FirstNodes<Dim, Kernel> first_nodes(s.grid.geo);
+    const auto reaches = [](const AxisInts& f, const NodeBox<Dim>& b) {
+      for (int a = 0; a < Dim; ++a) {
+        if (f[a] > b.hi[a] || f[a] + kSpan - 1 < b.lo[a]) return false;
+      }
+      return true;
+    };
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+    for (long p = 0; p < n; ++p) {
+      std::uint8_t r = 0;
+      if (requested(P, p)) {
+        if (all) {
+          r = kTransfer | kInterpolate;
+        } else {
+          const AxisInts f = first_nodes(P.x[p]);
+          if (reaches(f, transfer)) r |= kTransfer;
+          if (reaches(f, laplacian)) r |= kInterpolate;
+        }
+      }
+      reach_[p] = r;
+    }
+  }
+  int width() const {
+    return aniso_ ? kAnisoWidth : kIsoWidth;
+  }
+  Real m(long i) const {
+    return records_[i * width() + kM];
+  }
+  Real q(long i) const {
+    return records_[i * width() + kQ];
+  }
+  Real A(int c, long i) const {
+    return records_[i * width() + kA + c];
+  }
 
   // Zeroes the fields over the box of the previous call, then bins the particles
   // at their current positions into a new box: outside it every field is zero.
@@ -180,12 +300,13 @@ class NonlocalLaplacian {
     blocks_.bin(s.particles.x, geo, box_);
   }
 
-  void transfer_to_grid(const State<Dim>& s) {
+  // The particles marked kTransfer; the records divided by the mass over `nodes`.
+  void transfer_to_grid(const State<Dim>& s, const NodeBox<Dim>& nodes) {
     const auto& P = s.particles;
     const auto& geo = s.grid.geo;
     Real* const records = records_.data();
     blocks_.for_each_coloured(s, [&](int p) {
-      if (!requested(P, p)) return;
+      if (!(reach_[p] & kTransfer)) return;
       const LaplacianRequest& r = requests_[P.material[p]];
       const Real mp = P.m[p], mq = mp * P.state_of(p)[r.source];
       const StencilT st(P.x[p], P.F[p], geo);
@@ -202,7 +323,7 @@ class NonlocalLaplacian {
       st.add_to_records(geo, value, records);
     });
     const int W = width(), values = aniso_ ? 1 + kComponents : 1;
-    box_.for_each_node(geo.strides(), [&](long i) {
+    nodes.for_each_node(geo.strides(), [&](long i) {
       Real* record = records + i * W;
       if (record[kM] > 0) {
         for (int c = kQ; c < kQ + values; ++c) record[c] /= record[kM];
@@ -210,11 +331,11 @@ class NonlocalLaplacian {
     });
   }
 
-  // Over the box: a node with mass lies inside the particles' stencils, its
-  // neighbours inside the box's pad layers.
-  void grid_laplacian(const GridGeometry<Dim>& geo) {
+  // Over `nodes` (inside the box: a node with mass lies inside the particles'
+  // stencils, its neighbours inside the box's pad layers).
+  void grid_laplacian(const GridGeometry<Dim>& geo, const NodeBox<Dim>& nodes) {
     const Real inv_dx2 = 1 / (geo.dx * geo.dx);
-    box_.for_each_node(geo.strides(), [&](long i) {
+    nodes.for_each_node(geo.strides(), [&](long i) {
       if (!(m(i) > 0)) return;
       const auto idx = geo.multi_index(i);
       const Real q_i = q(i);
@@ -236,7 +357,9 @@ class NonlocalLaplacian {
     const int k = idx[a] + dir;
     return k >= 0 && k < geo.nodes(a) ? i + dir * geo.strides()[a] : -1;
   }
-  bool has_mass(long j) const { return j >= 0 && m(j) > 0; }
+  bool has_mass(long j) const {
+    return j >= 0 && m(j) > 0;
+  }
   // dx F_ab(j) = A_ab,j (q_{j+e_b} - q_{j-e_b}) / 2 at a node j with mass; a
   // neighbour without mass mirrors q_j.
   Real cross_flux(const GridGeometry<Dim>& geo, long j, const std::array<int, Dim>& idx, int a,
@@ -288,16 +411,23 @@ class NonlocalLaplacian {
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
     for (long p = 0; p < n; ++p) {
       if (!requested(P, p)) continue;
-      const StencilT st(P.x[p], P.F[p], geo);
       Real* q = P.state_of(p);
       const int target = requests_[P.material[p]].target;
+      if (!(reach_[p] & kInterpolate)) {  // lap_i = +0 over its stencil
+        q[target] = 0;
+        q[target + 1] = diagonal;
+        continue;
+      }
+      const StencilT st(P.x[p], P.F[p], geo);
       q[target] = st.interpolate(geo, lap_data);
       q[target + 1] = aniso_ ? st.interpolate(geo, diag_.data()) : diagonal;
     }
   }
 
   std::vector<LaplacianRequest> requests_;
-  bool aniso_ = false;  // any request anisotropic in this call
+  bool aniso_ = false;               // any request anisotropic in this call
+  bool localised_ = true;            // the isotropic path skips the exact zeros (header)
+  std::vector<std::uint8_t> reach_;  // Reach per particle
   // Over the whole grid, zero outside box_: the records (width() per node), and lap_i.
   std::vector<Real> records_, lap_;
   std::vector<Real> diag_;  // the anisotropic path's diagonal; empty until first used

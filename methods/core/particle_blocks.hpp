@@ -16,6 +16,47 @@
 
 namespace mpmtb {
 
+// The nodes a particle's stencil spans from its first node along an axis: the
+// support, or the stencil's own kSpan where its nodes may start later (CPDI's box).
+template <int Dim, class Kernel>
+constexpr int stencil_span() {
+  if constexpr (requires { Stencil<Dim, Kernel>::kSpan; }) {
+    return Stencil<Dim, Kernel>::kSpan;
+  } else {
+    return Kernel::support;
+  }
+}
+
+// The first stencil node per axis of a position (padded index, as Stencil's
+// base_node), every axis at once, one per lane, clamped so that a stray particle
+// cannot index out of range (the same operations lane by lane: perf showed the
+// axis-by-axis loop, with its branches for the bounds, at three quarters of the
+// binning).
+template <int Dim, class Kernel>
+class FirstNodes {
+ public:
+  explicit FirstNodes(const GridGeometry<Dim>& geo) : inv_dx_(geo.inv_dx) {
+    for (int a = 0; a < Dim; ++a) {
+      origin_[a] = geo.lo[a];
+      low_[a] = Real(-pad);
+      high_[a] = Real(geo.cells[a] + pad);
+    }
+  }
+  MPMTB_INLINE AxisInts operator()(const Vec<Dim>& x) const {
+    AxisPack xp{};
+    for (int a = 0; a < Dim; ++a) xp[a] = x[a];
+    AxisPack xi = (xp - origin_) * inv_dx_;
+    xi = xi < low_ ? low_ : xi;  // std::clamp's comparisons
+    xi = high_ < xi ? high_ : xi;
+    return Stencil<Dim, Kernel>::first_indices(xi) + pad;
+  }
+
+ private:
+  static constexpr int pad = GridGeometry<Dim>::pad;
+  AxisPack origin_{}, low_{}, high_{};
+  Real inv_dx_;
+};
+
 template <int Dim, class Kernel>
 class ParticleBlocks {
   using StencilT = Stencil<Dim, Kernel>;
@@ -33,17 +74,7 @@ class ParticleBlocks {
     constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
     const long n = static_cast<long>(x.size());
     first_.resize(n);
-    // The first stencil node per axis, as in Stencil, clamped so that a stray
-    // particle cannot index out of range: every axis at once, one per lane of an
-    // AxisPack (the same operations lane by lane: perf showed the axis-by-axis
-    // loop, with its branches for the bounds, at three quarters of the binning).
-    AxisPack origin{}, low{}, high{};
-    for (int a = 0; a < Dim; ++a) {
-      origin[a] = geo.lo[a];
-      low[a] = Real(-pad);
-      high[a] = Real(geo.cells[a] + pad);
-    }
-    const Real inv_dx = geo.inv_dx;
+    const FirstNodes<Dim, Kernel> first_nodes(geo);
     AxisInts lo = AxisInts{} + std::numeric_limits<int>::max();
     AxisInts hi = AxisInts{} + std::numeric_limits<int>::min();
     // Min and max are exact, so the box does not depend on the thread count.
@@ -52,12 +83,7 @@ class ParticleBlocks {
       AxisInts lo_t = lo, hi_t = hi;
 #pragma omp for schedule(static) nowait
       for (long p = 0; p < n; ++p) {
-        AxisPack xp{};
-        for (int a = 0; a < Dim; ++a) xp[a] = x[p][a];
-        AxisPack xi = (xp - origin) * inv_dx;
-        xi = xi < low ? low : xi;  // std::clamp's comparisons
-        xi = high < xi ? high : xi;
-        const AxisInts f = StencilT::first_indices(xi) + pad;
+        const AxisInts f = first_nodes(x[p]);
         lo_t = f < lo_t ? f : lo_t;
         hi_t = hi_t < f ? f : hi_t;
         for (int a = 0; a < kColouredAxes; ++a) first_[p][a] = f[a];
@@ -234,14 +260,8 @@ class ParticleBlocks {
   // all three axes in 3D, 8 colours, measured 23 % slower on the 3D block at one
   // thread: each colour's scatter sweeps most of the grid's sums, twice as often.)
   static constexpr int kColouredAxes = Dim >= 2 ? 2 : 1;
-  // The nodes a stencil spans from its first node along an axis: the support,
-  // or the stencil's own kSpan where its nodes may start later (CPDI's box).
   static constexpr int span() {
-    if constexpr (requires { StencilT::kSpan; }) {
-      return StencilT::kSpan;
-    } else {
-      return Kernel::support;
-    }
+    return stencil_span<Dim, Kernel>();
   }
   // A particle of block b (first nodes b W .. b W + W - 1) reaches nodes up to
   // b W + W + span - 2, short of block b + 2's first node (b + 2) W when

@@ -4,7 +4,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <string>
 #include <vector>
 
@@ -158,6 +160,54 @@ TEST(NonlocalLaplacian, ReusedAfterTheBodyMovesEqualsAFreshOperator) {
   for (std::size_t p = 0; p < P.size(); ++p) {
     ASSERT_EQ(P.state_of(p)[2], fresh_state.particles.state_of(p)[2]) << "particle " << p;
   }
+}
+
+// The local operator (the default: the isotropic path transfers, forms and
+// interpolates only near the particles with q_p != 0, core/nonlocal.hpp) gives
+// every particle the bits of the whole operator (localise(false)): for a field
+// zero everywhere, and for one nonzero only in a ball, inside the body and
+// across its corner (where the mirror condition acts).
+template <int Dim, class Kernel>
+void expect_local_equals_whole(int cells, const Vec<Dim>& centre, Real radius) {
+  const Scene scene =
+      testing::scene_from_toml(block_toml(Dim, cells, std::string(Kernel::name)), {.dim = Dim});
+  State<Dim> local_state = build_state<Dim>(scene), whole_state = build_state<Dim>(scene);
+  int nonzero = 0;
+  for (State<Dim>* s : {&local_state, &whole_state}) {
+    auto& P = s->particles;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      const Real r = (P.x[p] - centre).norm();
+      P.state_of(p)[0] = r < radius ? 1 + std::cos(P.x[p].sum()) : 0;
+      P.state_of(p)[2] = P.state_of(p)[3] = -1;  // overwritten by the operator
+    }
+  }
+  NonlocalLaplacian<Dim, Kernel> local, whole;
+  whole.localise(false);
+  local.apply(local_state);
+  whole.apply(whole_state);
+  const auto& P = local_state.particles;
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    for (const int slot : {2, 3}) {
+      const Real a = P.state_of(p)[slot], b = whole_state.particles.state_of(p)[slot];
+      ASSERT_EQ(std::bit_cast<std::uint64_t>(double(a)), std::bit_cast<std::uint64_t>(double(b)))
+          << "particle " << p << " slot " << slot << ": " << a << " vs " << b;
+    }
+    nonzero += P.state_of(p)[2] != 0;
+  }
+  if (radius > 0) {
+    EXPECT_GT(nonzero, 0) << "the field's Laplacian is nonzero near the ball";
+    EXPECT_LT(nonzero, static_cast<int>(P.size()) * 3 / 4) << "and zero far from it";
+  } else {
+    EXPECT_EQ(nonzero, 0);
+  }
+}
+
+TYPED_TEST(NonlocalLaplacianTest, LocalOperatorEqualsTheWholeOneBitForBit) {
+  expect_local_equals_whole<2, TypeParam>(32, Vec<2>(0.5, 0.45), 0.08);
+  expect_local_equals_whole<2, TypeParam>(32, Vec<2>(0.2, 0.8), 0.1);  // the body's corner
+  expect_local_equals_whole<2, TypeParam>(32, Vec<2>(0.5, 0.5), 0);    // zero everywhere
+  expect_local_equals_whole<3, TypeParam>(24, Vec<3>(0.45, 0.5, 0.55), 0.08);
+  expect_local_equals_whole<3, TypeParam>(24, Vec<3>(0.8, 0.2, 0.8), 0.1);
 }
 
 }  // namespace nonlocal_test
