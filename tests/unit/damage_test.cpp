@@ -233,6 +233,44 @@ TYPED_TEST(DamageTest, NoDamageBelowThreshold) {
   EXPECT_NEAR(q2[0], 0.2 + 1e-3 / 1e-3 * 0.2, 1e-9);
 }
 
+// eigenvalue_excess skips the eigenvalue solve where bounds show the stress
+// below the limit; the damage reads only the sign of a negative excess. So its
+// sign must be the solver's, and a positive excess the solver's own value, for
+// symmetric and unsymmetric stresses with their largest eigenvalue far below,
+// just below, at and above the limit, with strong shear (Gershgorin's bound
+// fails, Sylvester's criterion decides) and with repeated eigenvalues.
+TYPED_TEST(DamageTest, StressExcessHasTheSolversSign) {
+  constexpr int Dim = TestFixture::Dim;
+  if constexpr (Dim >= 2) {
+    std::uniform_real_distribution<Real> u(-1, 1);
+    int positive = 0, negative = 0;
+    for (int trial = 0; trial < 4000; ++trial) {
+      const Real top = kSigmaCrit * (trial % 4 == 0   ? 1 - std::pow(10.0, -2 - trial % 13)
+                                     : trial % 4 == 1 ? 1 + std::pow(10.0, -2 - trial % 13)
+                                     : trial % 4 == 2 ? 1 + 0.5 * u(this->gen_)
+                                                      : 1);
+      Vec<Dim> lambda;
+      for (int a = 0; a < Dim; ++a)
+        lambda[a] = top - (a == 0 ? 0 : (trial % 3) * kSigmaCrit * (1 + u(this->gen_)));
+      const Mat<Dim> R = RandomRotation<Dim>(this->gen_);
+      Mat<Dim> s = R * lambda.asDiagonal() * R.transpose();
+      const Mat<Dim> skew = 0.1 * kSigmaCrit * (trial % 2) * RandomMatrix<Dim>(this->gen_);
+      s += skew - skew.transpose();  // the symmetric part, and so the eigenvalues, kept
+      const Real solved = Damage<Dim>::max_symmetric_eigenvalue(s) - kSigmaCrit;
+      const Real excess = Damage<Dim>::eigenvalue_excess(s, kSigmaCrit);
+      ASSERT_EQ(excess > 0, solved > 0) << "trial " << trial << ": " << excess << " vs " << solved;
+      if (solved > 0) {
+        ASSERT_EQ(excess, solved) << "trial " << trial;
+        ++positive;
+      } else {
+        ++negative;
+      }
+    }
+    EXPECT_GT(positive, 500);
+    EXPECT_GT(negative, 500);
+  }
+}
+
 TEST(DamageOnset, StartsExactlyAtCriticalStressIn1D) {
   const auto m = MakeDamage<1>();
   Real q[4] = {0, 0, 0, 0};
