@@ -36,7 +36,7 @@ def read_rows(path):
 
 def plot_targets(rows, out_dir):
     picked = [r for r in rows
-              if r["case"] in ("target", "pinned_block", "snow88")]
+              if r["case"] in ("target", "pinned_block", "pinned_tearing", "snow88")]
     if not picked:
         return []
     fig, ax = mp.plt.subplots(figsize=(7.5, 1.2 + 0.42 * len(picked)))
