@@ -285,10 +285,38 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   void project_given_log(Mat<Dim>& F, Real logJ, Real* q, Real dt) const {
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
-    const Real d_new = advanced_damage(d_old, stress_excess(F, logJ), q, dt);
+    const Real excess = certainly_below_limit(F, logJ) ? -sigma_crit_ : stress_excess(F, logJ);
+    const Real d_new = advanced_damage(d_old, excess, q, dt);
     if (!(d_new > d_old)) return;
     q[kDissipated] += (degradation(d_old) - degradation(d_new)) * split(F).plus;
     q[kDamage] = d_new;
+  }
+  // True when sigma_max < sigma_crit (1 - 1e-9) is certain from a bound that
+  // needs neither the exp of J^(2/dim) nor the divisions by J of
+  // undamaged_cauchy: the undamaged tau is neo-Hookean's, mu F F^T + (lambda ln J
+  // - mu) I (the split's s terms cancel), and Gershgorin bounds its eigenvalues
+  // (as eigenvalue_excess), compared with J sigma_crit; the bound's own rounding,
+  // a few eps of the sum of its terms' magnitudes, is allowed for. Where it holds
+  // (most particles, most steps) the excess is negative, which is all the rate
+  // law reads of it; elsewhere the exact driver decides.
+  bool certainly_below_limit(const Mat<Dim>& F, Real logJ) const {
+    const Real J = F.determinant();
+    if (!(J > 0)) return false;
+    const Real shift = c_.lambda * logJ - c_.mu;
+    Real bound = -std::numeric_limits<Real>::infinity(), size = std::abs(shift);
+    for (int i = 0; i < Dim; ++i) {
+      Real row = shift, magnitude = 0;
+      for (int j = 0; j < Dim; ++j) {
+        Real FFt = F(i, 0) * F(j, 0);
+        for (int k = 1; k < Dim; ++k) FFt += F(i, k) * F(j, k);
+        row += i == j ? c_.mu * FFt : c_.mu * std::abs(FFt);
+        magnitude += c_.mu * std::abs(FFt);
+      }
+      bound = std::max(bound, row);
+      size += magnitude;
+    }
+    constexpr Real rounding = 32 * std::numeric_limits<Real>::epsilon();
+    return bound + rounding * size < sigma_crit_ * (1 - kBelowLimit) * J;
   }
   // The rate law's step from d_old < 1, driven by excess = sigma_max -
   // sigma_crit (the nonlocal terms from q when l0 > 0); d_old when it does not

@@ -271,6 +271,37 @@ TYPED_TEST(DamageTest, StressExcessHasTheSolversSign) {
   }
 }
 
+// project() skips the exact driver where an exp-free bound shows the stress
+// below sigma_crit (certainly_below_limit); the damage and the dissipated
+// energy must be those of the exact driver, bit for bit, for deformations
+// below, near and above the onset, with and without damage already.
+TYPED_TEST(DamageTest, ScreenedDriverGivesTheExactDriversDamage) {
+  constexpr int Dim = TestFixture::Dim;
+  const Damage<Dim>& m = this->m_;
+  constexpr Real dt = 1e-4;
+  int screened = 0, grown = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const Real amplitude = 0.05 + 0.1 * (trial % 5);
+    const Mat<Dim> F = testing::RandomF<Dim>(this->gen_, amplitude, 0.3);
+    const Real logJ = std::log(F.determinant()), d_old = trial % 3 == 0 ? 0.4 : 0;
+    Real q[4] = {d_old, 0.25, 0, 0}, expected[4] = {d_old, 0.25, 0, 0};
+    const Real d_new = m.advanced_damage(d_old, m.stress_excess(F, logJ), expected, dt);
+    if (d_new > d_old) {
+      expected[1] += (m.degradation(d_old) - m.degradation(d_new)) * m.split(F).plus;
+      expected[0] = d_new;
+      ++grown;
+    }
+    screened += m.certainly_below_limit(F, logJ);
+    Mat<Dim> G = F;
+    m.project_given_log(G, logJ, q, dt);
+    ASSERT_EQ(q[0], expected[0]) << "trial " << trial;
+    ASSERT_EQ(q[1], expected[1]) << "trial " << trial;
+    ASSERT_EQ(G, F) << "F is not changed";
+  }
+  EXPECT_GT(screened, 300) << "the bound decides for small deformations";
+  EXPECT_GT(grown, 300) << "and the exact driver where damage grows";
+}
+
 TEST(DamageOnset, StartsExactlyAtCriticalStressIn1D) {
   const auto m = MakeDamage<1>();
   Real q[4] = {0, 0, 0, 0};
