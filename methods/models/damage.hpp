@@ -300,9 +300,24 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   // (most particles, most steps) the excess is negative, which is all the rate
   // law reads of it; elsewhere the exact driver decides.
   bool certainly_below_limit(const Mat<Dim>& F, Real logJ) const {
-    const Real J = F.determinant();
+    return certainly_below_limit(F, F.determinant(), c_.lambda * logJ - c_.mu);
+  }
+  // The return map leaves the particle as it is (ModelBase::return_map then
+  // spares its logarithm): fully damaged, or the stress certainly below the
+  // threshold by the bound above with ln J bounded without the logarithm (ln J
+  // <= J - 1, and ln J >= 1 - 1/J for lambda < 0) and no growth from the
+  // nonlocal term either.
+  bool settled(const Mat<Dim>& F, Real J, const Real* q, Real dt) const {
+    const Real d_old = q[kDamage];
+    if (d_old >= 1) return true;
     if (!(J > 0)) return false;
-    const Real shift = c_.lambda * logJ - c_.mu;
+    const Real lnJ_bound = c_.lambda >= 0 ? J - 1 : 1 - 1 / J;
+    return certainly_below_limit(F, J, c_.lambda * lnJ_bound - c_.mu) &&
+           !(advanced_damage(d_old, -sigma_crit_, q, dt) > d_old);
+  }
+  // The bound for a given lambda ln J - mu (or an upper bound of it).
+  bool certainly_below_limit(const Mat<Dim>& F, Real J, Real shift) const {
+    if (!(J > 0)) return false;
     Real bound = -std::numeric_limits<Real>::infinity(), size = std::abs(shift);
     for (int i = 0; i < Dim; ++i) {
       Real row = shift, magnitude = 0;

@@ -10,6 +10,7 @@
 #include <span>
 #include <string>
 #include <string_view>
+#include <type_traits>
 #include <vector>
 
 #include "core/batch_log.hpp"
@@ -144,9 +145,22 @@ class ModelBase : public ConstitutiveModel<Dim> {
   }
   void return_map(Particles<Dim>& particles, std::span<const int> ids, Real dt) const override {
     if constexpr (requires(Mat<Dim> & F, Real * q) { self().project_given_log(F, 0, q, dt); }) {
-      for_each_with_log(particles, ids, [&](int p, Real logJ) {
-        self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
-      });
+      // A model that can tell from F, J and its state that its return map leaves
+      // a particle as it is (settled: damage's undamaged stress below the
+      // threshold) spares that particle's logarithm and call.
+      const auto settled = [&](int p, Real J) {
+        if constexpr (requires(const Mat<Dim>& F, const Real* q) { self().settled(F, J, q, dt); }) {
+          return self().settled(particles.F[p], J, particles.state_of(p), dt);
+        } else {
+          return false;
+        }
+      };
+      for_each_with_log(
+          particles, ids,
+          [&](int p, Real logJ) {
+            self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
+          },
+          settled);
     } else if constexpr (requires(Mat<Dim> & F, Real * q) { self().project(F, q, dt); }) {
       const long n = static_cast<long>(ids.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
@@ -176,22 +190,38 @@ class ModelBase : public ConstitutiveModel<Dim> {
   // Batches a thread takes at a time in for_each_chunk_balanced (256 particles:
   // 64 chunks per thread for the 32,768 particles of the 3D block at 2 threads).
   static constexpr long kLogChunk = 4;
-  // f(p, ln det F_p) for every particle p of ids, in parallel over batches of
-  // kLogBatch: each batch's logarithms first, in vector registers
-  // (core/batch_log.hpp), then f for its particles. For the models whose stress
-  // or return map needs ln J (tau_given_log, project_given_log).
-  template <class F>
-  static void for_each_with_log(const Particles<Dim>& particles, std::span<const int> ids, F&& f) {
+  // f(p, ln det F_p) for every particle p of ids but those where skip(p, det F_p)
+  // holds, in parallel over batches of kLogBatch: each batch's logarithms first,
+  // in vector registers (core/batch_log.hpp), then f for its particles. For the
+  // models whose stress or return map needs ln J (tau_given_log,
+  // project_given_log). (batch_log's lanes are independent: a value's logarithm
+  // does not depend on the batch it is in.)
+  struct NoSkip {};
+  template <class F, class Skip = NoSkip>
+  static void for_each_with_log(const Particles<Dim>& particles, std::span<const int> ids, F&& f,
+                                Skip&& skip = {}) {
+    constexpr bool skips = !std::is_same_v<std::decay_t<Skip>, NoSkip>;
     const long n = static_cast<long>(ids.size());
     const long batches = (n + kLogBatch - 1) / kLogBatch;
     for_each_chunk_balanced(batches, kLogChunk, n >= kParallelMinimum, [&](long from, long to) {
       for (long b = from; b < to; ++b) {
         const long first = b * kLogBatch;
-        const int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
+        int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
         Real J[kLogBatch], logJ[kLogBatch];
-        for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
+        int kept[kLogBatch];
+        if constexpr (skips) {
+          int m = 0;
+          for (int k = 0; k < count; ++k) {
+            const int p = ids[first + k];
+            const Real Jp = particles.F[p].determinant();
+            if (!skip(p, Jp)) J[m] = Jp, kept[m++] = p;
+          }
+          count = m;
+        } else {
+          for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
+        }
         batch_log(J, logJ, count);
-        for (int k = 0; k < count; ++k) f(ids[first + k], logJ[k]);
+        for (int k = 0; k < count; ++k) f(skips ? kept[k] : ids[first + k], logJ[k]);
       }
     });
   }

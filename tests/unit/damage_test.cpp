@@ -302,6 +302,34 @@ TYPED_TEST(DamageTest, ScreenedDriverGivesTheExactDriversDamage) {
   EXPECT_GT(grown, 300) << "and the exact driver where damage grows";
 }
 
+// settled() lets the return map skip a particle (and its logarithm): only
+// where project() would leave it exactly as it is, including the growth that
+// the nonlocal term alone drives (l0 > 0, lap d > 0 from damaged neighbours).
+TYPED_TEST(DamageTest, SettledParticlesAreLeftAsTheyAre) {
+  constexpr int Dim = TestFixture::Dim;
+  const Damage<Dim> m = MakeDamage<Dim>(With("l0", 0.02));
+  constexpr Real dt = 1e-4, diagonal = 2 * Dim * 64 * 64;  // dx = 1/64
+  int settled = 0, moving = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const Mat<Dim> F = testing::RandomF<Dim>(this->gen_, 0.05 + 0.1 * (trial % 4), 0.3);
+    const Real d_old = trial % 3 == 0 ? 0 : trial % 3 == 1 ? 0.4 : 1;
+    const Real lap = trial % 5 == 0 ? 50 : trial % 5 == 1 ? -50 : 0;
+    Real q[4] = {d_old, 0.25, lap, diagonal};
+    if (!m.settled(F, F.determinant(), q, dt)) {
+      ++moving;
+      continue;
+    }
+    ++settled;
+    const Real before[4] = {q[0], q[1], q[2], q[3]};
+    Mat<Dim> G = F;
+    m.project_given_log(G, std::log(F.determinant()), q, dt);
+    for (int k = 0; k < 4; ++k) ASSERT_EQ(q[k], before[k]) << "trial " << trial << " slot " << k;
+    ASSERT_EQ(G, F);
+  }
+  EXPECT_GT(settled, 500);
+  EXPECT_GT(moving, 300);
+}
+
 TEST(DamageOnset, StartsExactlyAtCriticalStressIn1D) {
   const auto m = MakeDamage<1>();
   Real q[4] = {0, 0, 0, 0};
