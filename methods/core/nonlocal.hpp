@@ -211,26 +211,13 @@ class NonlocalLaplacian {
   // thread count.
   NodeBox<Dim> source_nodes(const State<Dim>& s) const {
     const auto& P = s.particles;
-    const FirstNodes<Dim, Kernel> first_nodes(s.grid.geo);
-    const long n = static_cast<long>(P.size());
-    AxisInts lo = AxisInts{} + std::numeric_limits<int>::max();
-    AxisInts hi = AxisInts{} + std::numeric_limits<int>::min();
-#pragma omp parallel if (n >= kParallelMinimum)
-    {
-      AxisInts lo_t = lo, hi_t = hi;
-#pragma omp for schedule(static) nowait
-      for (long p = 0; p < n; ++p) {
-        if (!requested(P, p) || P.state_of(p)[requests_[P.material[p]].source] == 0) continue;
-        const AxisInts f = first_nodes(P.x[p]);
-        lo_t = f < lo_t ? f : lo_t;
-        hi_t = hi_t < f ? f : hi_t;
-      }
-#pragma omp critical(mpmtb_nonlocal_source)
-      {
-        lo = lo_t < lo ? lo_t : lo;
-        hi = hi < hi_t ? hi_t : hi;
-      }
-    }
+    const auto range = first_node_range<Dim, Kernel>(
+        s.grid.geo, static_cast<long>(P.size()),
+        [&](long p) {
+          return requested(P, p) && P.state_of(p)[requests_[P.material[p]].source] != 0;
+        },
+        [&](long p) -> const Vec<Dim>& { return P.x[p]; }, [](long, const AxisInts&) {});
+    const AxisInts lo = range.first, hi = range.second;
     NodeBox<Dim> box;
     for (int a = 0; a < Dim; ++a) {
       box.lo[a] = lo[a];

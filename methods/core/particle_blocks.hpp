@@ -8,6 +8,7 @@
 #include <array>
 #include <limits>
 #include <span>
+#include <utility>
 #include <vector>
 
 #include "core/state.hpp"
@@ -57,6 +58,36 @@ class FirstNodes {
   Real inv_dx_;
 };
 
+// The lowest and highest first node per axis (FirstNodes) over the particles
+// p < n for which take(p) holds, x(p) their positions; each(p, f) sees the first
+// nodes of every particle taken. {max int, min int} per lane when none is taken.
+// Min and max are exact, so the range does not depend on the thread count.
+template <int Dim, class Kernel, class Take, class Position, class Each>
+std::pair<AxisInts, AxisInts> first_node_range(const GridGeometry<Dim>& geo, long n, Take&& take,
+                                               Position&& x, Each&& each) {
+  const FirstNodes<Dim, Kernel> first_nodes(geo);
+  AxisInts lo = AxisInts{} + std::numeric_limits<int>::max();
+  AxisInts hi = AxisInts{} + std::numeric_limits<int>::min();
+#pragma omp parallel if (n >= kParallelMinimum)
+  {
+    AxisInts lo_t = lo, hi_t = hi;
+#pragma omp for schedule(static) nowait
+    for (long p = 0; p < n; ++p) {
+      if (!take(p)) continue;
+      const AxisInts f = first_nodes(x(p));
+      lo_t = f < lo_t ? f : lo_t;
+      hi_t = hi_t < f ? f : hi_t;
+      each(p, f);
+    }
+#pragma omp critical(mpmtb_first_node_range)
+    {
+      lo = lo_t < lo ? lo_t : lo;
+      hi = hi < hi_t ? hi_t : hi;
+    }
+  }
+  return {lo, hi};
+}
+
 template <int Dim, class Kernel>
 class ParticleBlocks {
   using StencilT = Stencil<Dim, Kernel>;
@@ -74,26 +105,12 @@ class ParticleBlocks {
     constexpr int S = Kernel::support, pad = GridGeometry<Dim>::pad;
     const long n = static_cast<long>(x.size());
     first_.resize(n);
-    const FirstNodes<Dim, Kernel> first_nodes(geo);
-    AxisInts lo = AxisInts{} + std::numeric_limits<int>::max();
-    AxisInts hi = AxisInts{} + std::numeric_limits<int>::min();
-    // Min and max are exact, so the box does not depend on the thread count.
-#pragma omp parallel if (n >= kParallelMinimum)
-    {
-      AxisInts lo_t = lo, hi_t = hi;
-#pragma omp for schedule(static) nowait
-      for (long p = 0; p < n; ++p) {
-        const AxisInts f = first_nodes(x[p]);
-        lo_t = f < lo_t ? f : lo_t;
-        hi_t = hi_t < f ? f : hi_t;
-        for (int a = 0; a < kColouredAxes; ++a) first_[p][a] = f[a];
-      }
-#pragma omp critical(mpmtb_bin_box)
-      {
-        lo = lo_t < lo ? lo_t : lo;
-        hi = hi < hi_t ? hi_t : hi;
-      }
-    }
+    const auto range = first_node_range<Dim, Kernel>(
+        geo, n, [](long) { return true; }, [&](long p) -> const Vec<Dim>& { return x[p]; },
+        [&](long p, const AxisInts& f) {
+          for (int a = 0; a < kColouredAxes; ++a) first_[p][a] = f[a];
+        });
+    const AxisInts lo = range.first, hi = range.second;
     for (int a = 0; a < Dim; ++a) {
       box.lo[a] = n ? std::max(0, lo[a] - pad) : 0;
       box.hi[a] = n ? std::min(geo.nodes(a) - 1, hi[a] + S - 1 + pad) : -1;
