@@ -41,6 +41,25 @@ struct Walls {
 
   // Before the velocity solve: folds ghost m, p, f onto mirror nodes.
   void fold(Grid<Dim>& grid) const;
+  // Whether a wall on `axis` has its face, ghost or mirror layers (the face's
+  // node -+ GridGeometry::pad) within `margin` nodes of the nodes first..last.
+  bool near(const GridGeometry<Dim>& geo, int axis, int first, int last, int margin) const {
+    constexpr int pad = GridGeometry<Dim>::pad;
+    for (int side = 0; side < 2; ++side) {
+      if (face[2 * axis + side] == Wall::free) continue;
+      const int f = side == 0 ? pad : pad + geo.cells[axis];
+      if (first - margin <= f + pad && last + margin >= f - pad) return true;
+    }
+    return false;
+  }
+  // Whether fold() can change the grid: a ghost layer meets the active box
+  // (outside it no node has mass; fold() acts only on ghosts with mass).
+  bool may_fold(const Grid<Dim>& grid) const {
+    for (int a = 0; a < Dim; ++a) {
+      if (near(grid.geo, a, grid.active.lo[a], grid.active.hi[a], 0)) return true;
+    }
+    return false;
+  }
   // After it: the face nodes' condition, and ghosts from their mirrors.
   void apply(Grid<Dim>& grid) const;
 };

@@ -95,7 +95,7 @@ class ParticleBlocks {
  public:
   // Sets the grid's active box to the nodes the particles' stencils reach, plus
   // GridGeometry::pad layers along every axis on which a wall is within reach
-  // (the mirrors of its ghosts: wall_within_reach), and sorts the particle ids
+  // (the mirrors of its ghosts), and sorts the particle ids
   // by colour, then block (a stable counting sort: particle order within a block).
   void bin(State<Dim>& s) { bin(s.particles.x, s.grid.geo, s.grid.active, &s.walls); }
   // Sizes (and touches) the per-particle arrays for n particles ahead of the first bin().
@@ -114,8 +114,13 @@ class ParticleBlocks {
         });
     const AxisInts lo = range.first, hi = range.second;
     for (int a = 0; a < Dim; ++a) {
-      const int margin =
-          !walls || wall_within_reach(*walls, geo, a, lo[a], hi[a] + S - 1) ? pad : 0;
+      // The pad only along an axis with a wall within reach: there the grid
+      // update must sweep the mirror of every ghost a stencil reaches (a
+      // particle on the face reaches ghosts two nodes out with the cubic
+      // B-spline, but mirrors only one node in). Elsewhere the pad's nodes have
+      // no mass and no stencil reads them: the pinned block's box (4 cells
+      // thick) had 10 nodes per row with it, 6 without, and twice the nodes.
+      const int margin = !walls || walls->near(geo, a, lo[a], hi[a] + S - 1, pad) ? pad : 0;
       box.lo[a] = n ? std::max(0, lo[a] - margin) : 0;
       box.hi[a] = n ? std::min(geo.nodes(a) - 1, hi[a] + S - 1 + margin) : -1;
     }
@@ -277,25 +282,6 @@ class ParticleBlocks {
   }
 
  private:
-  // Whether a wall on `axis` may fold ghosts onto, or set ghosts from, nodes near
-  // the stencils' nodes first..last along it: its face, ghost and mirror layers
-  // (face -+ pad) come within pad nodes of them. Only then does the active box
-  // need the pad along that axis, so that the mirror of every ghost a stencil
-  // reaches is swept by the grid update (a particle on the face reaches ghosts
-  // two nodes out with the cubic B-spline, but mirrors only one node in).
-  // Elsewhere the pad's nodes have no mass and no stencil reads them: without
-  // it, the pinned block's box (4 cells thick) had 10 nodes per row instead
-  // of 6, twice the nodes in every grid pass for the same results.
-  static bool wall_within_reach(const Walls<Dim>& walls, const GridGeometry<Dim>& geo, int axis,
-                                int first, int last) {
-    constexpr int pad = GridGeometry<Dim>::pad;
-    for (int side = 0; side < 2; ++side) {
-      if (walls.face[2 * axis + side] == Wall::free) continue;
-      const int face = side == 0 ? pad : pad + geo.cells[axis];
-      if (first - pad <= face + pad && last + pad >= face - pad) return true;
-    }
-    return false;
-  }
   // Blocks over the first two axes (one in 1D), 2^axes colours. (Blocks over
   // all three axes in 3D, 8 colours, measured 23 % slower on the 3D block at one
   // thread: each colour's scatter sweeps most of the grid's sums, twice as often.)

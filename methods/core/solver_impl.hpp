@@ -115,14 +115,20 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     const bool parallel = g.active_nodes() >= kParallelMinimum;
     const Vec<Dim> gravity = s.gravity;
     // Skipped without gravity: adding m_i 0 changes no value (only -0 to +0).
-    if (gravity != Vec<Dim>::Zero())
-      for_each_active_node(g, [&](long i) { g.f[i] += g.m[i] * gravity; });
-    s.walls.fold(g);
+    // Where the walls cannot fold (no ghost layer meets the box) the body force
+    // is added in the update's own loop, the same operations node by node,
+    // instead of in a pass of its own over m_i and f_i before the fold.
+    const bool has_gravity = gravity != Vec<Dim>::Zero();
+    const bool folds = s.walls.may_fold(g);
+    const bool gravity_in_update = has_gravity && !folds;
+    if (has_gravity && folds) for_each_active_node(g, [&](long i) { g.f[i] += g.m[i] * gravity; });
+    if (folds) s.walls.fold(g);
     Real rx = 0, ry = 0, rz = 0;  // reaction of the pinned nodes
 #pragma omp parallel for schedule(static) reduction(+ : rx, ry, rz) if (parallel)
     for (long r = 0; r < rows; ++r) {
       const auto [first, count] = g.active_row(r);
       for (long i = first; i < first + count; ++i) {
+        if (gravity_in_update) g.f[i] += g.m[i] * gravity;
         if (g.m[i] > 0) {
           const Real inv_m = 1 / g.m[i];
           const Vec<Dim> v_old = g.p[i] * inv_m;

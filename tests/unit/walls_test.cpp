@@ -126,5 +126,34 @@ TEST(Pins, PinnedParticlesStayPutUnderGravity) {
   }
 }
 
+// The grid update skips fold() (and adds gravity in its own loop) where
+// Walls::may_fold says that no ghost layer meets the active box. Checked
+// against fold() itself, which must then change nothing: for a body against a
+// sticky wall (fold() acts) and one a few cells from every wall (it is skipped).
+TEST(Walls, FoldIsSkippedOnlyWhereItCannotAct) {
+  for (const char* kernel : {"quadratic", "cubic"}) {
+    for (const bool at_wall : {true, false}) {
+      const std::string toml = testing::free_body_toml(
+          2, "mls", kernel, "[boundary]\nx_min = \"sticky\"\nx_max = \"slip\"\n");
+      Scene scene = testing::scene_from_toml(toml, {.dim = 2});
+      // Against the sticky wall, or 6.4 cells from it and 6 from the slip wall.
+      scene.bodies[0].min = Vec3(at_wall ? 0 : 0.4, 0.35, 0);
+      State<2> s = build_state<2>(scene);
+      Parameters params;
+      auto st = make_stepper<2>("mls", kernel, params);
+      st->particles_to_grid(s, 1e-3);
+      Grid<2> folded = s.grid;
+      s.walls.fold(folded);
+      const bool changed = folded.m != s.grid.m || folded.p != s.grid.p;
+      const bool may_fold = s.walls.may_fold(s.grid);
+      if (!may_fold) {
+        EXPECT_FALSE(changed) << kernel << ": fold() acted where it was skipped";
+      }
+      EXPECT_EQ(changed, at_wall) << kernel;
+      EXPECT_EQ(may_fold, at_wall) << kernel;
+    }
+  }
+}
+
 }  // namespace walls_test
 }  // namespace mpmtb
