@@ -155,12 +155,20 @@ class ModelBase : public ConstitutiveModel<Dim> {
           return false;
         }
       };
-      for_each_with_log(
-          particles, ids,
-          [&](int p, Real logJ) {
-            self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
-          },
-          settled);
+      const auto project = [&](int p, Real logJ) {
+        self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
+      };
+      if constexpr (requires(const int* batch, Real* J, int* kept) {
+                      self().unsettled(particles, batch, 0, dt, J, kept);
+                    }) {
+        // The model screens a batch at a time (Damage::unsettled: in vector lanes).
+        for_each_with_log(particles, ids, project,
+                          [&](const int* batch, int count, Real* J, int* kept) {
+                            return self().unsettled(particles, batch, count, dt, J, kept);
+                          });
+      } else {
+        for_each_with_log(particles, ids, project, settled);
+      }
     } else if constexpr (requires(Mat<Dim> & F, Real * q) { self().project(F, q, dt); }) {
       const long n = static_cast<long>(ids.size());
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
@@ -191,8 +199,10 @@ class ModelBase : public ConstitutiveModel<Dim> {
   // 64 chunks per thread for the 32,768 particles of the 3D block at 2 threads).
   static constexpr long kLogChunk = 4;
   // f(p, ln det F_p) for every particle p of ids but those where skip(p, det F_p)
-  // holds, in parallel over batches of kLogBatch: each batch's logarithms first,
-  // in vector registers (core/batch_log.hpp), then f for its particles. For the
+  // holds (or, for a skip that takes a batch, skip(ids, count, J, kept) writes
+  // det F and the ids of those kept, and returns their count), in parallel over
+  // batches of kLogBatch: each batch's logarithms first, in vector registers
+  // (core/batch_log.hpp), then f for its particles. For the
   // models whose stress or return map needs ln J (tau_given_log,
   // project_given_log). (batch_log's lanes are independent: a value's logarithm
   // does not depend on the batch it is in.)
@@ -209,7 +219,9 @@ class ModelBase : public ConstitutiveModel<Dim> {
         int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
         Real J[kLogBatch], logJ[kLogBatch];
         int kept[kLogBatch];
-        if constexpr (skips) {
+        if constexpr (std::is_invocable_r_v<int, Skip, const int*, int, Real*, int*>) {
+          count = skip(&ids[first], count, J, kept);  // det F and the ids kept, batch-wise
+        } else if constexpr (skips) {
           int m = 0;
           for (int k = 0; k < count; ++k) {
             const int p = ids[first + k];

@@ -3,7 +3,9 @@
 
 #include <Eigen/Eigenvalues>
 #include <Eigen/Geometry>
+#include <bit>
 #include <cmath>
+#include <cstdint>
 #include <map>
 #include <numbers>
 #include <random>
@@ -15,6 +17,7 @@
 
 #include "core/errors.hpp"
 #include "core/parameters.hpp"
+#include "core/particles.hpp"
 #include "core/types.hpp"
 #include "models/damage.hpp"
 #include "models/neo_hookean.hpp"
@@ -328,6 +331,50 @@ TYPED_TEST(DamageTest, SettledParticlesAreLeftAsTheyAre) {
   }
   EXPECT_GT(settled, 500);
   EXPECT_GT(moving, 300);
+}
+
+// The return map screens its particles a vector register at a time
+// (Damage::unsettled, ModelBase::return_map): the same answer as settled()
+// particle by particle, and det F bit for bit as Eigen's, which the logarithm
+// then takes. Particles near the threshold, inverted (J <= 0), fully damaged,
+// with lap d of either sign, with and without the nonlocal term, and a count
+// that leaves a partial register.
+TYPED_TEST(DamageTest, BatchScreenAgreesWithTheParticleScreen) {
+  constexpr int Dim = TestFixture::Dim;
+  constexpr Real dt = 1e-4, diagonal = 2 * Dim * 64 * 64;
+  for (const Real l0 : {0.02, 0.0}) {
+    const Damage<Dim> m = MakeDamage<Dim>(With("l0", l0));
+    Particles<Dim> P;
+    P.state_size = 4;
+    for (int p = 0; p < 203; ++p) {
+      P.add(Vec<Dim>::Zero(), Vec<Dim>::Zero(), 1, 1, 0);
+      P.F[p] = testing::RandomF<Dim>(this->gen_, 0.05 + 0.1 * (p % 4), 0.3);
+      if (p % 17 == 0) P.F[p].row(0) *= -1;  // inverted
+      const Real d_old = p % 3 == 0 ? 0 : p % 3 == 1 ? 0.4 : 1;
+      const Real lap = p % 5 == 0 ? 50 : p % 5 == 1 ? -50 : 0;
+      for (const Real q : {d_old, Real(0.25), lap, diagonal}) P.state.push_back(q);
+    }
+    std::vector<int> ids(P.size());
+    for (std::size_t p = 0; p < ids.size(); ++p) ids[p] = static_cast<int>(ids.size() - 1 - p);
+    std::vector<Real> J(ids.size());
+    std::vector<int> kept(ids.size());
+    const int count =
+        m.unsettled(P, ids.data(), static_cast<int>(ids.size()), dt, J.data(), kept.data());
+    int expected = 0;
+    for (const int p : ids) {
+      const Real det = P.F[p].determinant();
+      if (m.settled(P.F[p], det, P.state_of(p), dt)) continue;
+      ASSERT_LT(expected, count) << "l0 " << l0 << ": particle " << p << " was screened out";
+      EXPECT_EQ(kept[expected], p) << "l0 " << l0;
+      EXPECT_EQ(std::bit_cast<std::uint64_t>(double(J[expected])),
+                std::bit_cast<std::uint64_t>(double(det)))
+          << "l0 " << l0 << ": det F of particle " << p;
+      ++expected;
+    }
+    EXPECT_EQ(count, expected) << "l0 " << l0;
+    EXPECT_GT(expected, 20) << "l0 " << l0;
+    EXPECT_LT(expected, 183) << "l0 " << l0;
+  }
 }
 
 TEST(DamageOnset, StartsExactlyAtCriticalStressIn1D) {
