@@ -184,6 +184,14 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
                                   Mat<Dim>& out) const {
     tau_entries(F, logJ, degradation(damage(q)), [&](int i, int j, Real t) { out(i, j) = V0 * t; });
   }
+  // In 3D the stress pass takes s = J^(2/3) = exp(kPowerOfLog ln J) a batch at
+  // a time too (ModelBase::kirchhoff_times_volume, core/batch_exp.hpp).
+  static constexpr Real kPowerOfLog = Real(2) / 3;
+  void tau_times_volume_given_log_and_power(const Mat<Dim>& F, Real logJ, Real s, const Real* q,
+                                            Real V0, Mat<Dim>& out) const requires(Dim == 3) {
+    tau_entries(F, logJ, s, degradation(damage(q)),
+                [&](int i, int j, Real t) { out(i, j) = V0 * t; });
+  }
   // Undamaged Cauchy stress sigma = tau(F, d = 0) / J: the damage driver.
   Mat<Dim> undamaged_cauchy(const Mat<Dim>& F) const {
     return undamaged_cauchy(F, std::log(F.determinant()));
@@ -467,7 +475,12 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   // pinned block).
   template <class Out>
   MPMTB_INLINE void tau_entries(const Mat<Dim>& F, Real logJ, Real g, Out&& out) const {
-    const Real J = F.determinant(), s = pow_2_over_dim(J, logJ);
+    tau_entries(F, logJ, pow_2_over_dim(F.determinant(), logJ), g, out);
+  }
+  // The same with s = J^(2/dim) given.
+  template <class Out>
+  MPMTB_INLINE void tau_entries(const Mat<Dim>& F, Real logJ, Real s, Real g, Out&& out) const {
+    const Real J = F.determinant();
     const Real vol = c_.mu * (s - 1) + c_.lambda * logJ;
     const bool tensile = J >= 1;
     for (int j = 0; j < Dim; ++j) {

@@ -13,6 +13,7 @@
 #include <type_traits>
 #include <vector>
 
+#include "core/batch_exp.hpp"
 #include "core/batch_log.hpp"
 #include "core/particles.hpp"
 #include "core/thread_split.hpp"
@@ -121,8 +122,16 @@ class ModelBase : public ConstitutiveModel<Dim> {
   void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
                               std::vector<Mat<Dim>>& tauV) const override {
     if constexpr (requires(const Mat<Dim>& F, const Real* q, Mat<Dim>& out) {
-                    self().tau_times_volume_given_log(F, 0, q, 1, out);
+                    self().tau_times_volume_given_log_and_power(F, 0, 1, q, 1, out);
                   }) {
+      // A power of J too, exp(c ln J), batch-wise (damage's J^(2/3) in 3D).
+      for_each_with_log(particles, ids, [&](int p, Real logJ, Real power) {
+        self().tau_times_volume_given_log_and_power(
+            particles.F[p], logJ, power, particles.state_of(p), particles.V0[p], tauV[p]);
+      });
+    } else if constexpr (requires(const Mat<Dim>& F, const Real* q, Mat<Dim>& out) {
+                           self().tau_times_volume_given_log(F, 0, q, 1, out);
+                         }) {
       for_each_with_log(particles, ids, [&](int p, Real logJ) {
         self().tau_times_volume_given_log(particles.F[p], logJ, particles.state_of(p),
                                           particles.V0[p], tauV[p]);
@@ -205,7 +214,8 @@ class ModelBase : public ConstitutiveModel<Dim> {
   // (core/batch_log.hpp), then f for its particles. For the
   // models whose stress or return map needs ln J (tau_given_log,
   // project_given_log). (batch_log's lanes are independent: a value's logarithm
-  // does not depend on the batch it is in.)
+  // does not depend on the batch it is in.) An f that takes a third argument
+  // gets exp(Derived::kPowerOfLog ln det F_p) too (core/batch_exp.hpp).
   struct NoSkip {};
   template <class F, class Skip = NoSkip>
   static void for_each_with_log(const Particles<Dim>& particles, std::span<const int> ids, F&& f,
@@ -233,7 +243,14 @@ class ModelBase : public ConstitutiveModel<Dim> {
           for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
         }
         batch_log(J, logJ, count);
-        for (int k = 0; k < count; ++k) f(skips ? kept[k] : ids[first + k], logJ[k]);
+        if constexpr (std::is_invocable_v<F, int, Real, Real>) {
+          Real exponent[kLogBatch], power[kLogBatch];
+          for (int k = 0; k < count; ++k) exponent[k] = Derived::kPowerOfLog * logJ[k];
+          batch_exp(exponent, power, count);
+          for (int k = 0; k < count; ++k) f(skips ? kept[k] : ids[first + k], logJ[k], power[k]);
+        } else {
+          for (int k = 0; k < count; ++k) f(skips ? kept[k] : ids[first + k], logJ[k]);
+        }
       }
     });
   }
