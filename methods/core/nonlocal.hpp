@@ -108,11 +108,8 @@ class NonlocalLaplacian {
     NodeBox<Dim> transfer = everywhere(), laplacian = everywhere();
     if (!aniso_ && localised_) {
       const NodeBox<Dim> source = source_nodes(s);
-      if (source.nodes() == 0) {  // q_p = 0 everywhere: lap_p = +0 everywhere
-        reach_.assign(s.particles.size(), 0);
-        interpolate_back(s);
-        return;
-      }
+      // q_p = 0 everywhere: lap_p = +0 everywhere, which source_nodes wrote.
+      if (source.nodes() == 0) return;
       transfer = grown(source, 2), laplacian = grown(source, 1);
     }
     mark_reach(s, transfer, laplacian);
@@ -209,12 +206,22 @@ class NonlocalLaplacian {
   // The nodes that the requesting particles with q_p != 0 (or NaN) reach; empty
   // when there are none. Min and max are exact: the box does not depend on the
   // thread count.
-  NodeBox<Dim> source_nodes(const State<Dim>& s) const {
-    const auto& P = s.particles;
+  // It also writes every requested particle's lap_p = +0 (and the diagonal),
+  // interpolate_back's answer for a particle that reaches no nonzero lap_i: in
+  // the same sweep over q_p, and a field zero everywhere then needs no other
+  // (elsewhere interpolate_back writes every particle's lap_p again).
+  NodeBox<Dim> source_nodes(State<Dim>& s) const {
+    auto& P = s.particles;
+    const Real diagonal = 2 * Dim / (s.grid.geo.dx * s.grid.geo.dx);
     const auto range = first_node_range<Dim, Kernel>(
         s.grid.geo, static_cast<long>(P.size()),
         [&](long p) {
-          return requested(P, p) && P.state_of(p)[requests_[P.material[p]].source] != 0;
+          if (!requested(P, p)) return false;
+          Real* q = P.state_of(p);
+          const LaplacianRequest& r = requests_[P.material[p]];
+          q[r.target] = 0;
+          q[r.target + 1] = diagonal;
+          return q[r.source] != 0;
         },
         [&](long p) -> const Vec<Dim>& { return P.x[p]; }, [](long, const AxisInts&) {});
     const AxisInts lo = range.first, hi = range.second;
