@@ -4,11 +4,8 @@
 // (for J^(2/3) = exp(2/3 ln J)).
 #pragma once
 
-#include <algorithm>
 #include <bit>
 #include <cmath>
-#include <cstring>
-#include <limits>
 
 #include "core/batch_log.hpp"
 
@@ -72,28 +69,11 @@ constexpr Real inverse_factorial(int k) {
 // y[k] = e^x[k] for k < n, a register of lanes at a time. Values outside the
 // range where e^x is a normal number (and NaN) get std::exp's result.
 inline void batch_exp(const Real* x, Real* y, int n) {
-  using detail::kLogLanes;
-  using detail::LogPack;
   using C = detail::ExpConstants<Real>;
-  for (int k0 = 0; k0 < n; k0 += kLogLanes) {
-    const int lanes = std::min(kLogLanes, n - k0);
-    LogPack v{};
-    if (lanes == kLogLanes) {
-      std::memcpy(&v, x + k0, sizeof v);
-    } else {
-      for (int l = 0; l < lanes; ++l) v[l] = x[k0 + l];
-    }
-    const auto in_range = (v >= C::lowest) & (v <= C::highest);
-    const LogPack r = detail::exp_in_range(in_range ? v : LogPack{});
-    if (lanes == kLogLanes) {
-      std::memcpy(y + k0, &r, sizeof r);
-    } else {
-      for (int l = 0; l < lanes; ++l) y[k0 + l] = r[l];
-    }
-    for (int l = 0; l < lanes; ++l) {
-      if (!in_range[l]) y[k0 + l] = std::exp(x[k0 + l]);
-    }
-  }
+  detail::batch_apply(
+      x, y, n, [](detail::LogPack v) { return (v >= C::lowest) & (v <= C::highest); }, Real(0),
+      [](detail::LogPack v) { return detail::exp_in_range(v); },
+      [](Real a) { return std::exp(a); });
 }
 
 }  // namespace mpmtb

@@ -80,6 +80,33 @@ inline constexpr int kLogLanes = kSimdBytes / sizeof(Real);
   return E * ln2_head + (ln_m + E * ln2_tail);
 }
 
+// y[k] = vector(x[k]) for k < n, a register of lanes at a time, for the lanes
+// where valid holds (the others go through vector as `safe`), and scalar(x[k])
+// for the others: the batch loop of batch_log and batch_exp (core/batch_exp.hpp).
+template <class Valid, class Vector, class Scalar>
+inline void batch_apply(const Real* x, Real* y, int n, Valid&& valid, Real safe, Vector&& vector,
+                        Scalar&& scalar) {
+  for (int k0 = 0; k0 < n; k0 += kLogLanes) {
+    const int lanes = std::min(kLogLanes, n - k0);
+    LogPack v = LogPack{} + safe;
+    if (lanes == kLogLanes) {
+      std::memcpy(&v, x + k0, sizeof v);
+    } else {
+      for (int l = 0; l < lanes; ++l) v[l] = x[k0 + l];
+    }
+    const auto ok = valid(v);
+    const LogPack r = vector(ok ? v : LogPack{} + safe);
+    if (lanes == kLogLanes) {
+      std::memcpy(y + k0, &r, sizeof r);
+    } else {
+      for (int l = 0; l < lanes; ++l) y[k0 + l] = r[l];
+    }
+    for (int l = 0; l < lanes; ++l) {
+      if (!ok[l]) y[k0 + l] = scalar(x[k0 + l]);
+    }
+  }
+}
+
 }  // namespace detail
 
 // y[k] = ln x[k] for k < n, a register of lanes at a time. Values that are not
@@ -87,29 +114,12 @@ inline constexpr int kLogLanes = kSimdBytes / sizeof(Real);
 // subnormals) get std::log's result, so the unstable-run checks see what they
 // saw before.
 inline void batch_log(const Real* x, Real* y, int n) {
-  using detail::kLogLanes;
-  using detail::LogPack;
   const Real lowest_normal = std::numeric_limits<Real>::min();
   const Real largest = std::numeric_limits<Real>::max();
-  for (int k0 = 0; k0 < n; k0 += kLogLanes) {
-    const int lanes = std::min(kLogLanes, n - k0);
-    LogPack v = LogPack{} + Real(1);
-    if (lanes == kLogLanes) {
-      std::memcpy(&v, x + k0, sizeof v);
-    } else {
-      for (int l = 0; l < lanes; ++l) v[l] = x[k0 + l];
-    }
-    const auto normal = (v >= lowest_normal) & (v <= largest);
-    const LogPack r = detail::log_of_normal(normal ? v : LogPack{} + Real(1));
-    if (lanes == kLogLanes) {
-      std::memcpy(y + k0, &r, sizeof r);
-    } else {
-      for (int l = 0; l < lanes; ++l) y[k0 + l] = r[l];
-    }
-    for (int l = 0; l < lanes; ++l) {
-      if (!normal[l]) y[k0 + l] = std::log(x[k0 + l]);
-    }
-  }
+  detail::batch_apply(
+      x, y, n, [&](detail::LogPack v) { return (v >= lowest_normal) & (v <= largest); }, Real(1),
+      [](detail::LogPack v) { return detail::log_of_normal(v); },
+      [](Real a) { return std::log(a); });
 }
 
 }  // namespace mpmtb
