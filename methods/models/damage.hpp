@@ -312,8 +312,9 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   bool certainly_below_limit(const Mat<Dim>& F, Real logJ) const {
     return certainly_below_limit(F, F.determinant(), c_.lambda * logJ - c_.mu);
   }
-  // The return map leaves the particle as it is (ModelBase::return_map then
-  // spares its logarithm): fully damaged, or the stress certainly below the
+  // The return map leaves the particle as it is (the particle-by-particle
+  // statement; the return map screens with unsettled(), its lanes, which the
+  // tests hold to it): fully damaged, or the stress certainly below the
   // threshold by the bound above with ln J bounded without the logarithm (ln J
   // <= J - 1, and ln J >= 1 - 1/J for lambda < 0) and no growth from the
   // nonlocal term either.

@@ -155,28 +155,21 @@ class ModelBase : public ConstitutiveModel<Dim> {
   void return_map(Particles<Dim>& particles, std::span<const int> ids, Real dt) const override {
     if constexpr (requires(Mat<Dim> & F, Real * q) { self().project_given_log(F, 0, q, dt); }) {
       // A model that can tell from F, J and its state that its return map leaves
-      // a particle as it is (settled: damage's undamaged stress below the
-      // threshold) spares that particle's logarithm and call.
-      const auto settled = [&](int p, Real J) {
-        if constexpr (requires(const Mat<Dim>& F, const Real* q) { self().settled(F, J, q, dt); }) {
-          return self().settled(particles.F[p], J, particles.state_of(p), dt);
-        } else {
-          return false;
-        }
-      };
+      // a particle as it is (Damage::unsettled: the undamaged stress below the
+      // threshold, a vector register of particles at a time) spares that
+      // particle's logarithm and call.
       const auto project = [&](int p, Real logJ) {
         self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
       };
       if constexpr (requires(const int* batch, Real* J, int* kept) {
                       self().unsettled(particles, batch, 0, dt, J, kept);
                     }) {
-        // The model screens a batch at a time (Damage::unsettled: in vector lanes).
         for_each_with_log(particles, ids, project,
                           [&](const int* batch, int count, Real* J, int* kept) {
                             return self().unsettled(particles, batch, count, dt, J, kept);
                           });
       } else {
-        for_each_with_log(particles, ids, project, settled);
+        for_each_with_log(particles, ids, project);
       }
     } else if constexpr (requires(Mat<Dim> & F, Real * q) { self().project(F, q, dt); }) {
       const long n = static_cast<long>(ids.size());
@@ -207,9 +200,9 @@ class ModelBase : public ConstitutiveModel<Dim> {
   // Batches a thread takes at a time in for_each_chunk_balanced (256 particles:
   // 64 chunks per thread for the 32,768 particles of the 3D block at 2 threads).
   static constexpr long kLogChunk = 4;
-  // f(p, ln det F_p) for every particle p of ids but those where skip(p, det F_p)
-  // holds (or, for a skip that takes a batch, skip(ids, count, J, kept) writes
-  // det F and the ids of those kept, and returns their count), in parallel over
+  // f(p, ln det F_p) for every particle p of ids but those a skip screens out
+  // (skip(ids, count, J, kept) writes det F and the ids of the particles kept
+  // of a batch, and returns their count), in parallel over
   // batches of kLogBatch: each batch's logarithms first, in vector registers
   // (core/batch_log.hpp), then f for its particles. For the
   // models whose stress or return map needs ln J (tau_given_log,
@@ -229,16 +222,8 @@ class ModelBase : public ConstitutiveModel<Dim> {
         int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
         Real J[kLogBatch], logJ[kLogBatch];
         int kept[kLogBatch];
-        if constexpr (std::is_invocable_r_v<int, Skip, const int*, int, Real*, int*>) {
-          count = skip(&ids[first], count, J, kept);  // det F and the ids kept, batch-wise
-        } else if constexpr (skips) {
-          int m = 0;
-          for (int k = 0; k < count; ++k) {
-            const int p = ids[first + k];
-            const Real Jp = particles.F[p].determinant();
-            if (!skip(p, Jp)) J[m] = Jp, kept[m++] = p;
-          }
-          count = m;
+        if constexpr (skips) {
+          count = skip(&ids[first], count, J, kept);  // det F and the ids kept
         } else {
           for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
         }
