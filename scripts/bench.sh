@@ -5,8 +5,9 @@
 # draws it: analysis/bench_plots.py).
 #   REPEATS=5 (default)  rounds; each case's median over them is reported
 #   QUICK=1              only the pinned block and the 2D snow scene
-#   MPMTB_ARCH=auto      passed to cmake for both builds (-march; auto: x86-64-v3
-#                        where the machine has it, as the default build)
+#   MPMTB_ARCH=auto      passed to cmake for both builds (-march; auto: x86-64-v4
+#                        where the machine has AVX-512, else x86-64-v3, as the
+#                        default build; the yardsticks use -march=native)
 # The machine is shared and noisy: compare ratios measured in the same run, and
 # read load_1min_max (the highest 1-minute load average seen when the case ran)
 # beside each row.

@@ -150,15 +150,19 @@ struct Row {
 };
 
 // A stencil row: the N = S * W values of the S nodes along the grid's fastest
-// axis (W per node, consecutive in memory), as the fewest registers: the widest
-// packs first, then narrower ones (12 doubles: 8 + 4 with AVX-512, 4 + 4 + 4 with
-// AVX2). The transfers' last axis works on whole strips, so a row of nodes costs
-// one load, one add and one store per register instead of per node.
+// axis (W per node, consecutive in memory), as the fewest registers of at most 32
+// bytes: the widest packs first, then narrower ones (12 doubles: 4 + 4 + 4, 12
+// floats: 8 + 4). The transfers' last axis works on whole strips, so a row of
+// nodes costs one load, one add and one store per register instead of per node.
+// (With AVX-512, 8 + 4 doubles measured 4 % slower on the 3D block than 4 + 4 + 4,
+// likely because the next particle's stencil row, a node further on, loads across
+// two of the previous one's stores, which a core cannot forward; G2P's strips,
+// which only load, measured the same either way.)
 template <int N>
 struct Strip {
   static constexpr int count = N;
   static constexpr int bytes = [] {
-    int b = kSimdBytes;
+    int b = std::min(kSimdBytes, 32);
     while (b > 16 && b > N * static_cast<int>(sizeof(Real))) b /= 2;
     return b;
   }();

@@ -75,6 +75,10 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   using Base::v_rows_;
   // Particles whose stencils G2P computes together (for_each_in_run).
   static constexpr int kRun = 8;
+  // P2G takes the policy's FoldedForm (core/tensor_transfer.hpp) where the sums
+  // are folded and the kernel's transfer has it (CPDI's has not).
+  static constexpr bool kFoldedForm =
+      kTensorPath && kFoldForce && takes_folded_form<Dim, Kernel, Policy>;
 
  public:
   Solver(Parameters& transfer_params) : Base(kTensorPath), transfer_params_(transfer_params) {}
@@ -343,7 +347,15 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     Real* m = g.m.data();
     Vec<Dim>* mom = g.p.data();
     Vec<Dim>* f = g.f.data();
-    if constexpr (kTensorPath) {
+    if constexpr (kFoldedForm) {
+      FoldedForm<Dim> form;
+      policy.folded_form(src, form);
+      if (kBodyForce && s.body_force) {
+        const Vec<Dim> mb = P.m[p] * s.body_force(P, p, s.time);
+        for (int a = 0; a < Dim; ++a) form.alpha_f[1 + a] += mb[a];
+      }
+      this->template add_folded_form<Policy::scatter_terms>(st, g.geo, form, dt);
+    } else if constexpr (kTensorPath) {
       ScatterForm<Dim> form;
       policy.scatter_form(src, form);
       if (kBodyForce && s.body_force) {

@@ -69,6 +69,12 @@ class SolverStages : public Stepper<Dim> {
       Sums::template scatter<T>(st, geo, form, sums_.data());
     }
   }
+  // The same from a policy's FoldedForm (folded sums only).
+  template <TensorTerms T>
+  void add_folded_form(const StencilT& st, const GridGeometry<Dim>& geo,
+                       const FoldedForm<Dim>& form, Real dt) requires(kFold&& Dim >= 2) {
+    Sums::template scatter_folded_form<T>(st, geo, form, dt, sums_.data());
+  }
 
   // The gathers' input: v and v_old (if the rows hold it) packed over the active
   // box (VelocityRows), which holds every stencil of the particles that scattered.

@@ -61,6 +61,15 @@ class ApicPolicy {
     momentum_form(s, form);
     for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(F_::f) = -s.tauV.col(a);
   }
+  // The same columns in whole registers, for folded sums (FoldedForm).
+  using FoldedPath = ApicPolicy;
+  void folded_form(const Source& s, FoldedForm<Dim>& form) const requires(Dim >= 2) {
+    folded_momentum_form(s, form);
+    [&]<int... a>(std::integer_sequence<int, a...>) MPMTB_INLINE_LAMBDA {
+      ((form.beta_f[a] = -column_lanes<a>(s.tauV)), ...);
+    }
+    (std::make_integer_sequence<int, Dim>{});
+  }
 
   struct Gather {
     V v = V::Zero();
@@ -120,10 +129,8 @@ class ApicPolicy {
         C[a] = G[a];
       }
     }
-    for (int b = 0; b < Dim; ++b) {
-      P.v[p][b] = v[b];
-      for (int a = 0; a < Dim; ++a) P.C[p](b, a) = C[a][b];
-    }
+    for (int b = 0; b < Dim; ++b) P.v[p][b] = v[b];
+    store_columns<Dim>(P.C[p], C);
     if constexpr (kFfromC) {
       deformation_update<Dim>(P.F[p], C, dt);
     } else {
@@ -136,6 +143,13 @@ class ApicPolicy {
     form.alpha[F_::m] = s.m;
     form.alpha.template segment<Dim>(F_::p) = s.mv;
     for (int a = 0; a < Dim; ++a) form.gamma[a].template segment<Dim>(F_::p) = s.m * s.C.col(a);
+  }
+  void folded_momentum_form(const Source& s, FoldedForm<Dim>& form) const {
+    form.set_mass_momentum(s.m, s.mv);
+    [&]<int... a>(std::integer_sequence<int, a...>) MPMTB_INLINE_LAMBDA {
+      ((form.gamma_mp[a] = s.m * column_lanes<a>(s.C)), ...);
+    }
+    (std::make_integer_sequence<int, Dim>{});
   }
   // m_i += w m_p, p_i += w m_p (v_p + C_p (x_i - x_p)): shared with MLS-MPM.
   void scatter_momentum(const Source& s, Real w, const V& d, Real& m_i, V& p_i) const {

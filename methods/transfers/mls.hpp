@@ -53,6 +53,22 @@ class MlsPolicy : public ApicPolicy<Dim, Kernel> {
     }
   }
 
+  // The same columns in whole registers, for folded sums (FoldedForm).
+  using FoldedPath = MlsPolicy;
+  void folded_form(const Source& s, FoldedForm<Dim>& form) const requires(Dim >= 2) {
+    this->folded_momentum_form(s, form);
+    [&]<int... a>(std::integer_sequence<int, a...>) MPMTB_INLINE_LAMBDA {
+      if constexpr (Kernel::constant_inertia) {
+        ((form.gamma_f[a] = -this->moments_.D_inv() * column_lanes<a>(s.tauV)), ...);
+      } else if constexpr (AffineMoments<Dim, Kernel>::per_particle) {
+        ((form.gamma_f[a] = -s.D_inv[a] * column_lanes<a>(s.tauV)), ...);
+      } else {
+        ((form.beta_f[a] = -column_lanes<a>(s.tauV)), ...);
+      }
+    }
+    (std::make_integer_sequence<int, Dim>{});
+  }
+
   struct Gather {
     V v = V::Zero();
     M C = M::Zero();

@@ -51,6 +51,15 @@ class PicPolicy {
     form.alpha.template segment<Dim>(F::p) = s.mv;
     for (int a = 0; a < Dim; ++a) form.beta[a].template segment<Dim>(F::f) = -s.tauV.col(a);
   }
+  // The same columns in whole registers, for folded sums (FoldedForm).
+  using FoldedPath = PicPolicy;
+  void folded_form(const Source& s, FoldedForm<Dim>& form) const requires(Dim >= 2) {
+    form.set_mass_momentum(s.m, s.mv);
+    [&]<int... a>(std::integer_sequence<int, a...>) MPMTB_INLINE_LAMBDA {
+      ((form.beta_f[a] = -column_lanes<a>(s.tauV)), ...);
+    }
+    (std::make_integer_sequence<int, Dim>{});
+  }
 
   struct Gather {
     V v = V::Zero();

@@ -5,6 +5,8 @@
 // Also: the kernels' branch-free weights equal N and dN at every support node.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cstring>
 #include <random>
 #include <string>
 
@@ -32,7 +34,7 @@ Vec<Dim> random_vector(std::mt19937& rng) {
 using testing::relative_gap;
 
 template <int Dim, class Kernel, class Transfer>
-void check_fast_path_matches_per_node(const std::string& what, int* checked) {
+void check_fast_path_matches_per_node(const std::string& what, int* checked, int* folded_forms) {
   using Policy = typename Transfer::template Policy<Dim, Kernel>;
   if constexpr (!Transfer::template supports<Kernel> || !has_tensor_path<Policy>()) {
     return;
@@ -93,6 +95,27 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
       for (std::size_t n = 0; n < ref.size(); ++n) p_dt_f[n] = ref.p[n] + dt * ref.f[n];
       EXPECT_LT(relative_gap(ref.m, fold.m), 1e-14) << what << " folded m_i";
       EXPECT_LT(relative_gap(p_dt_f, fold.p), 1e-14) << what << " folded p_i + dt f_i";
+      // A policy's own FoldedForm (whole-register columns) folds to the same
+      // sums, bit for bit, as its ScatterForm.
+      if constexpr (takes_folded_form<Dim, Kernel, Policy>) {
+        FoldedForm<Dim> direct;
+        policy.folded_form(src, direct);
+        NodeSums<Dim, true> from_columns, from_direct;
+        from_columns.resize(fast.size());
+        from_direct.resize(fast.size());
+        TensorTransfer<Dim, Kernel>::template scatter_folded<Policy::scatter_terms>(
+            st, geo, form, dt, from_columns.data());
+        TensorTransfer<Dim, Kernel>::template scatter_folded_form<Policy::scatter_terms>(
+            st, geo, direct, dt, from_direct.data());
+        EXPECT_GT(std::count_if(from_columns.values.begin(), from_columns.values.end(),
+                                [](Real x) { return x != 0; }),
+                  0)
+            << what;
+        EXPECT_EQ(0, std::memcmp(from_direct.values.data(), from_columns.values.data(),
+                                 from_columns.values.size() * sizeof(Real)))
+            << what << " FoldedForm";
+        ++*folded_forms;
+      }
 
       // G2P from a random velocity field: v_p, C_p, F_p, x_p.
       for (std::size_t n = 0; n < ref.size(); ++n) {
@@ -119,16 +142,17 @@ void check_fast_path_matches_per_node(const std::string& what, int* checked) {
 }
 
 TEST(TensorTransfer, FastPathMatchesPerNodeMathForEveryTransferKernelAndDimension) {
-  int checked = 0;
+  int checked = 0, folded_forms = 0;
   AllTransfers::for_each([&]<class T>() {
     AllKernels::for_each([&]<class K>() {
       const std::string what = std::string(T::name) + "/" + std::string(K::name);
-      check_fast_path_matches_per_node<1, K, T>(what + "/1d", &checked);
-      check_fast_path_matches_per_node<2, K, T>(what + "/2d", &checked);
-      check_fast_path_matches_per_node<3, K, T>(what + "/3d", &checked);
+      check_fast_path_matches_per_node<1, K, T>(what + "/1d", &checked, &folded_forms);
+      check_fast_path_matches_per_node<2, K, T>(what + "/2d", &checked, &folded_forms);
+      check_fast_path_matches_per_node<3, K, T>(what + "/3d", &checked, &folded_forms);
     });
   });
   EXPECT_GT(checked, 0) << "no transfer declares the fast path";
+  EXPECT_GT(folded_forms, 0) << "no transfer writes a FoldedForm";
 }
 
 // The branch-free weights a kernel may provide equal N(r) and dN(r) at the
