@@ -1,14 +1,15 @@
 #!/usr/bin/env bash
-# Installs what is missing, builds, and runs the default test set: the unit,
-# verification and end-to-end labels, and the provenance gate (label gate: the
-# reference set compared with results/baseline/, scripts/gate.sh). Long sweeps
+# Installs what is missing, builds, and runs the default test set: the unit and
+# verification tests (as label shards: the same tests in a few processes,
+# tests/CMakeLists.txt), the end-to-end label, and the provenance gate (label
+# gate: the reference set compared with results/baseline/, scripts/gate.sh). Long sweeps
 # carry other labels and run from scripts/suite.sh. Then the sanitizer stage and
 # a bounded fuzz run of the scene parser.
 set -euo pipefail
 cd "$(dirname "$0")/.."
 # Only what the default set runs: not the sweep tests or the benchmarks.
 MPMTB_TARGETS="mpmtb mpmtb_unit_tests mpmtb_verification_tests" bash scripts/build.sh
-(cd build && ctest -L 'unit|verification|e2e|gate' --output-on-failure -j "$(nproc)")
+(cd build && ctest -L 'shards|e2e|gate' --output-on-failure -j "$(nproc)")
 # Sanitizer stage: the unit tests again, built with ASan + UBSan in ./build-asan.
 # (Built in the background at nice 19 beside the Release tree instead, it gained
 # nothing: the default tests ran 25 % longer with it, 258 s against 206.)
