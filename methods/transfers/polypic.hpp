@@ -179,14 +179,82 @@ struct PolyModes {
   template <bool Transpose, int A, class Node>
   MPMTB_INLINE void apply_axis(const Node* __restrict x, Node* __restrict y) const {
     constexpr int stride = ipow(S, Dim - 1 - A), outer = ipow(S, A);
+    if constexpr (kPaired<Node>) {
+      apply_axis_paired<Transpose, A>(x, y);
+    } else {
+      for (int o = 0; o < outer; ++o)
+        for (int n = 0; n < S; ++n)
+          for (int i = 0; i < stride; ++i) one_output<Transpose, A>(x, y, o, n, i);
+    }
+  }
+  // y[first + n stride] = sum_k W(n, k) x[first + k stride], first = o S stride + i.
+  template <bool Transpose, int A, class Node>
+  MPMTB_INLINE void one_output(const Node* __restrict x, Node* __restrict y, int o, int n,
+                               int i) const {
+    constexpr int stride = ipow(S, Dim - 1 - A);
+    const int first = o * S * stride + i;
+    Node acc = coefficient<Transpose, A>(n, 0) * x[first];
+    for (int k = 1; k < S; ++k)
+      acc.add_scaled(coefficient<Transpose, A>(n, k), x[first + k * stride]);
+    y[first + n * stride] = acc;
+  }
+
+  // Two outputs per register where two nodes' rows fill one (AVX-512 with 3D
+  // double rows, AVX with 2D ones): half the multiply-adds. Along the last axis
+  // (stride 1) the pair is outputs n and n + 1 of one line, the same inputs with
+  // two coefficients; along the others it is nodes i and i + 1, side by side in
+  // memory, with one coefficient. Every lane takes the same operations in the same
+  // order as one_output, so the results are the same bits.
+  // (Odd supports keep one output per register: with a node left over in every
+  // line, the quadratic B-spline's pairs measured 2 % slower.)
+  template <class Node>
+  static constexpr bool kPaired = S % 2 == 0 && Node::K == 1 && 2 * sizeof(Node) <= kSimdBytes;
+
+  template <bool Transpose, int A, class Node>
+  MPMTB_INLINE void apply_axis_paired(const Node* __restrict x, Node* __restrict y) const {
+    constexpr int stride = ipow(S, Dim - 1 - A), outer = ipow(S, A);
+    constexpr int L = Node::lanes;
+    using Pair = typename PackOf<2 * sizeof(Node)>::type;
+    const auto load = [](const Node* at) MPMTB_INLINE_LAMBDA {
+      Pair p;
+      std::memcpy(&p, at, sizeof p);
+      return p;
+    };
+    const auto twice = [](const Node& r) MPMTB_INLINE_LAMBDA {  // (r, r)
+      return [&]<int... l>(std::integer_sequence<int, l...>) MPMTB_INLINE_LAMBDA {
+        return __builtin_shufflevector(r.v[0], r.v[0], (l % L)...);
+      }
+      (std::make_integer_sequence<int, 2 * L>{});
+    };
+    const auto halves = [](Real lo, Real hi) MPMTB_INLINE_LAMBDA {  // (lo..., hi...)
+      return [&]<int... l>(std::integer_sequence<int, l...>) MPMTB_INLINE_LAMBDA {
+        return Pair{(l < L ? lo : hi)...};
+      }
+      (std::make_integer_sequence<int, 2 * L>{});
+    };
     for (int o = 0; o < outer; ++o) {
-      for (int n = 0; n < S; ++n) {
-        for (int i = 0; i < stride; ++i) {
-          const int first = o * S * stride + i;
-          Node acc = coefficient<Transpose, A>(n, 0) * x[first];
-          for (int k = 1; k < S; ++k)
-            acc.add_scaled(coefficient<Transpose, A>(n, k), x[first + k * stride]);
-          y[first + n * stride] = acc;
+      if constexpr (stride == 1) {
+        const Node* line = x + o * S;
+        for (int n = 0; n + 1 < S; n += 2) {
+          const auto w = [&](int k) MPMTB_INLINE_LAMBDA {
+            return halves(coefficient<Transpose, A>(n, k), coefficient<Transpose, A>(n + 1, k));
+          };
+          Pair acc = w(0) * twice(line[0]);
+          for (int k = 1; k < S; ++k) acc = fused(w(k), twice(line[k]), acc);
+          std::memcpy(y + o * S + n, &acc, sizeof acc);
+        }
+        if constexpr (S % 2 == 1) one_output<Transpose, A>(x, y, o, S - 1, 0);
+      } else {
+        for (int n = 0; n < S; ++n) {
+          for (int i = 0; i + 1 < stride; i += 2) {
+            const int first = o * S * stride + i;
+            Pair acc = coefficient<Transpose, A>(n, 0) * load(x + first);
+            for (int k = 1; k < S; ++k)
+              acc = fused(coefficient<Transpose, A>(n, k) - Pair{}, load(x + first + k * stride),
+                          acc);
+            std::memcpy(y + first + n * stride, &acc, sizeof acc);
+          }
+          if constexpr (stride % 2 == 1) one_output<Transpose, A>(x, y, o, n, stride - 1);
         }
       }
     }
