@@ -52,6 +52,20 @@ typename Policy::Gather begin_gather(const Policy& policy, const Stencil<Dim, Ke
   }
 }
 
+// With TensorTerms::nodal: the stencil sums and the stencil's rows into a
+// Gather begun at the same stencil (begin_gather), in place. (The solver calls
+// this on its own Gather: returned from tensor_gather, PolyPIC's Gather, a
+// stencil's rows and modes, was copied whole, three copies of 2 KB per particle.)
+template <class Policy, int Dim, class Kernel>
+MPMTB_INLINE inline void tensor_gather_into(const Policy& policy, const Stencil<Dim, Kernel>& st,
+                                            const GridGeometry<Dim>& g, const Real* rows,
+                                            typename Policy::Gather& gather) {
+  constexpr TensorTerms terms = Policy::gather_terms;
+  static_assert(terms.nodal);
+  policy.gather_from(
+      TensorTransfer<Dim, Kernel>::template gather<terms>(st, g, rows, gather.v_data()), gather);
+}
+
 // G2P on the fast path: the policy's Gather from the packed velocity rows
 // (VelocityRows) around the particle.
 template <class Policy, int Dim, class Kernel>
@@ -63,7 +77,7 @@ MPMTB_INLINE inline typename Policy::Gather tensor_gather(const Policy& policy,
   using Sums = TensorTransfer<Dim, Kernel>;
   if constexpr (terms.nodal) {
     typename Policy::Gather gather = begin_gather(policy, st);
-    policy.gather_from(Sums::template gather<terms>(st, g, rows, gather.v_data()), gather);
+    tensor_gather_into(policy, st, g, rows, gather);
     return gather;
   } else {
     return policy.gather_from(Sums::template gather<terms>(st, g, rows));

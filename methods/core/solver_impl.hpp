@@ -57,6 +57,14 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   // v_old by a polynomial in the particle projection (filter_old_velocity; XPIC).
   // A tensor-path policy that finishes G2P from the stencil sums in registers.
   static constexpr bool kFinishRows = kTensorPath && has_finish_rows<Policy>();
+  // G2P's stencil rows go to the policy's Gather (TensorTerms::nodal: PolyPIC).
+  static constexpr bool kNodalGather = [] {
+    if constexpr (kTensorPath) {
+      return Policy::gather_terms.nodal;
+    } else {
+      return false;
+    }
+  }();
   static constexpr bool kFiltersOldVelocity = requires(const Policy& q) {
     q.old_velocity_series();
   };
@@ -252,13 +260,16 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
                 } else {
                   // Initialised in place (core/policy_hooks.hpp): an assignment would copy the
                   // policy's Gather, which for PolyPIC holds a stencil's worth of rows.
+                  // (PolyPIC's, TensorTerms::nodal, is filled in place: tensor_gather_into.)
                   typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
-                    if constexpr (kTensorPath) {
+                    if constexpr (kTensorPath && !kNodalGather) {
                       return tensor_gather(policy, st, g.geo, rows_.data());
                     } else {
                       return begin_gather(policy, st);
                     }
                   }();
+                  if constexpr (kNodalGather)
+                    tensor_gather_into(policy, st, g.geo, rows_.data(), gather);
                   if constexpr (!kTensorPath) {
                     st.for_each_node(
                         g.geo, [&](long node, Real w, const Vec<Dim>& grad, const Vec<Dim>& d) {
