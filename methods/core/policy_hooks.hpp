@@ -86,12 +86,10 @@ MPMTB_INLINE inline typename Policy::Gather tensor_gather(const Policy& policy,
 
 // True when Policy itself (not only a base class) finishes from the rows.
 template <class Policy>
+using FinishRowsOf = typename Policy::FinishRows;
+template <class Policy>
 constexpr bool has_finish_rows() {
-  if constexpr (requires { typename Policy::FinishRows; }) {
-    return std::is_same_v<typename Policy::FinishRows, Policy>;
-  } else {
-    return false;
-  }
+  return names_itself<FinishRowsOf, Policy>();
 }
 
 }  // namespace mpmtb

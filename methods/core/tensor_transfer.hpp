@@ -193,24 +193,32 @@ struct GatherSums {
   Vec<Dim> D_inv = Vec<Dim>::Zero();
 };
 
-// True when Policy itself (not only a base class) opts in to the fast path.
-template <class Policy>
-constexpr bool has_tensor_path() {
-  if constexpr (requires { typename Policy::TensorPath; }) {
-    return std::is_same_v<typename Policy::TensorPath, Policy>;
+// A policy opts in to a path by naming itself in a member type (`using
+// TensorPath = ThisPolicy;`): true when Member<Policy> is Policy itself, so that a
+// policy derived from one that opted in (and inherits its member) does not.
+template <template <class> class Member, class Policy>
+constexpr bool names_itself() {
+  if constexpr (requires { typename Member<Policy>; }) {
+    return std::is_same_v<Member<Policy>, Policy>;
   } else {
     return false;
   }
+}
+template <class Policy>
+using TensorPathOf = typename Policy::TensorPath;
+template <class Policy>
+using FoldedPathOf = typename Policy::FoldedPath;
+
+// True when Policy itself (not only a base class) opts in to the fast path.
+template <class Policy>
+constexpr bool has_tensor_path() {
+  return names_itself<TensorPathOf, Policy>();
 }
 
 // True when Policy itself writes the FoldedForm (FoldedForm above).
 template <class Policy>
 constexpr bool has_folded_form() {
-  if constexpr (requires { typename Policy::FoldedPath; }) {
-    return std::is_same_v<typename Policy::FoldedPath, Policy>;
-  } else {
-    return false;
-  }
+  return names_itself<FoldedPathOf, Policy>();
 }
 
 template <int Dim, class Kernel>
