@@ -6,6 +6,7 @@
 #include <utility>
 #include <vector>
 
+#include "huge_pages.hpp"
 #include "types.hpp"
 
 namespace mpmtb {
@@ -139,12 +140,12 @@ struct Grid {
 
   explicit Grid(const GridGeometry<Dim>& g = {}) : geo(g) {
     const auto n = static_cast<std::size_t>(g.node_count());
-    m.assign(n, 0);
-    p.assign(n, Vec<Dim>::Zero());
-    f.assign(n, Vec<Dim>::Zero());
-    v.assign(n, Vec<Dim>::Zero());
-    v_old.assign(n, Vec<Dim>::Zero());
-    pinned.assign(n, 0);
+    assign_on_huge_pages(m, n, Real(0));
+    assign_on_huge_pages(p, n, Vec<Dim>(Vec<Dim>::Zero()));
+    assign_on_huge_pages(f, n, Vec<Dim>(Vec<Dim>::Zero()));
+    assign_on_huge_pages(v, n, Vec<Dim>(Vec<Dim>::Zero()));
+    assign_on_huge_pages(v_old, n, Vec<Dim>(Vec<Dim>::Zero()));
+    assign_on_huge_pages(pinned, n, std::uint8_t{0});
   }
   std::size_t size() const { return m.size(); }
 

@@ -81,6 +81,7 @@
 #include <limits>
 #include <vector>
 
+#include "core/huge_pages.hpp"
 #include "core/particle_blocks.hpp"
 #include "core/state.hpp"
 #include "core/stencil.hpp"
@@ -175,7 +176,8 @@ class NonlocalLaplacian {
     const int W = width();
     const bool fresh = records_.size() != n * W;
     if (fresh) {
-      records_.assign(n * W, 0), lap_.assign(n, 0);
+      assign_on_huge_pages(records_, n * W, Real(0));
+      assign_on_huge_pages(lap_, n, Real(0));
       diag_.clear();
     }
     if (aniso_ && diag_.size() != n) diag_.assign(n, 0);

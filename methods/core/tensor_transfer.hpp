@@ -22,6 +22,7 @@
 #include <utility>
 #include <vector>
 
+#include "core/huge_pages.hpp"
 #include "core/pack.hpp"
 #include "core/stencil.hpp"
 #include "core/types.hpp"
@@ -82,7 +83,7 @@ struct NodeSums {
 
   // Sized for a grid of `nodes` nodes, all zero when the size changes.
   void resize(std::size_t nodes) {
-    if (values.size() != nodes * N) values.assign(nodes * N, Real(0));
+    if (values.size() != nodes * N) assign_on_huge_pages(values, nodes * N, Real(0));
   }
   Real* data() { return values.data(); }
   // Zeroes `count` consecutive nodes from `first`.
@@ -166,7 +167,7 @@ struct VelocityRows {
   std::vector<Real> values;          // N per node, node-major
 
   void resize(std::size_t nodes) {
-    if (values.size() != nodes * N) values.assign(nodes * N, Real(0));
+    if (values.size() != nodes * N) assign_on_huge_pages(values, nodes * N, Real(0));
   }
   const Real* data() const { return values.data(); }
   // Packs `count` consecutive nodes from `first` (v_old is read only when kOld).
