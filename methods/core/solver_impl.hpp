@@ -140,15 +140,26 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     for (long r = 0; r < rows; ++r) {
       const auto [first, count] = g.active_row(r);
       for (long i = first; i < first + count; ++i) {
-        if (gravity_in_update) g.f[i] += g.m[i] * gravity;
+        // With folded sums (kFoldForce) p_i already holds dt times the internal
+        // and body forces, and f_i, zero before, is gravity alone: formed here,
+        // not loaded from a field no other stage of the step reads (perf: that
+        // load missed the cache, most of the pinned block's grid update), and
+        // not stored (nothing reads it before the next step clears it). Where
+        // the walls fold, f_i was loaded and folded before this loop.
+        Vec<Dim> f_i;
+        if (kFoldForce && !folds) {
+          f_i = gravity_in_update ? Vec<Dim>(g.m[i] * gravity) : Vec<Dim>::Zero();
+        } else {
+          if (gravity_in_update) g.f[i] += g.m[i] * gravity;
+          f_i = g.f[i];
+        }
         if (g.m[i] > 0) {
           const Real inv_m = 1 / g.m[i];
           const Vec<Dim> v_old = g.p[i] * inv_m;
           if constexpr (Transfer::needs_old_velocity) g.v_old[i] = v_old;
-          // Symplectic Euler: v_i^{n+1} = v_i^n + dt f_i / m_i (f_i includes m_i g).
-          // With folded sums (kFoldForce) p_i already holds dt times the internal
-          // and body forces, and f_i is gravity alone; v_old is then not kept.
-          g.v[i] = v_old + dt * inv_m * g.f[i];
+          // Symplectic Euler: v_i^{n+1} = v_i^n + dt f_i / m_i (f_i includes m_i g);
+          // v_old is not kept for folded sums.
+          g.v[i] = v_old + dt * inv_m * f_i;
           if (g.pinned[i]) {
             const Vec3 reaction = to3<Dim>(-g.m[i] * g.v[i]);
             rx += reaction[0], ry += reaction[1], rz += reaction[2];
