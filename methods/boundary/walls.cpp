@@ -39,9 +39,11 @@ Vec<Dim> reflected(Wall w, int axis, const Vec<Dim>& v) {
 }
 
 // Calls fn(wall, axis, outward, face_node, one_step_outward) for every node on
-// every face that has a wall.
+// every face that has a wall; with a box, only on the faces whose nodes, ghosts
+// or mirrors (pad layers either side) it meets.
 template <int Dim, class Fn>
-void for_each_face_node(const Walls<Dim>& walls, const GridGeometry<Dim>& geo, Fn&& fn) {
+void for_each_face_node(const Walls<Dim>& walls, const GridGeometry<Dim>& geo,
+                        const NodeBox<Dim>* box, Fn&& fn) {
   constexpr int pad = GridGeometry<Dim>::pad;
   for (int axis = 0; axis < Dim; ++axis) {
     const long stride = geo.strides()[axis];
@@ -52,6 +54,7 @@ void for_each_face_node(const Walls<Dim>& walls, const GridGeometry<Dim>& geo, F
       if (w == Wall::free) continue;
       const int outward = side == 0 ? -1 : 1;
       const int face_index = side == 0 ? pad : pad + geo.cells[axis];
+      if (box && (box->lo[axis] > face_index + pad || box->hi[axis] < face_index - pad)) continue;
       for (long o = 0; o < outer; ++o) {
         for (long s = 0; s < stride; ++s) {
           fn(w, axis, outward, o * block + face_index * stride + s, outward * stride);
@@ -72,7 +75,8 @@ int mirrored_layers(const GridGeometry<Dim>& geo, int axis) {
 
 template <int Dim>
 void Walls<Dim>::fold(Grid<Dim>& grid) const {
-  for_each_face_node(*this, grid.geo, [&](Wall w, int axis, int, long face, long out) {
+  const NodeBox<Dim>* every_face = nullptr;
+  for_each_face_node(*this, grid.geo, every_face, [&](Wall w, int axis, int, long face, long out) {
     if (w == Wall::separate) return;
     for (int k = 1; k <= mirrored_layers(grid.geo, axis); ++k) {
       const long ghost = face + k * out, mirror = face - k * out;
@@ -87,7 +91,12 @@ void Walls<Dim>::fold(Grid<Dim>& grid) const {
 template <int Dim>
 void Walls<Dim>::apply(Grid<Dim>& grid) const {
   constexpr int pad = GridGeometry<Dim>::pad;
-  for_each_face_node(*this, grid.geo, [&](Wall w, int axis, int outward, long face, long out) {
+  // Only on the faces the active box meets: outside it every velocity is zero,
+  // and the condition on a face it does not meet changed only the sign of zeros,
+  // on nodes no particle reads (perf: the pinned block's floor, far below it,
+  // cost 2 % of its step).
+  const NodeBox<Dim>* box = &grid.active;
+  for_each_face_node(*this, grid.geo, box, [&](Wall w, int axis, int outward, long face, long out) {
     // Also on face nodes without mass: at a corner they are another face's ghosts,
     // mirrored before this face's condition was applied to their mirrors.
     apply_wall<Dim>(w, axis, outward, grid.v[face]);
