@@ -26,6 +26,7 @@
 #include "core/pack.hpp"
 #include "core/stencil.hpp"
 #include "core/types.hpp"
+#include "core/velocity_rows.hpp"
 
 namespace mpmtb {
 
@@ -153,34 +154,6 @@ MPMTB_INLINE inline AxisPack column_lanes(const Mat<Dim>& M) {
     return __builtin_shufflevector(v, zero, 4, 2 * a, 2 * a + 1, 4);
   }
 }
-
-// G2P's input: for every grid node v_i (and, for the transfers that read it,
-// v_i_old) padded to whole SIMD registers (core/pack.hpp), side by side, so
-// that a node's contribution to every sum is a few SIMD operations. The solver
-// packs the grid's velocities once per gather, over the active box.
-template <int Dim, bool kOld>
-struct VelocityRows {
-  static constexpr int width = Dim == 3 ? 4 : Dim;                       // v_i and its padding
-  static constexpr int min_reals = 16 / static_cast<int>(sizeof(Real));  // one SSE register
-  static constexpr int N = std::max((kOld ? 2 : 1) * width, min_reals);
-  static constexpr int old = width;  // slot of v_old
-  std::vector<Real> values;          // N per node, node-major
-
-  void resize(std::size_t nodes) {
-    if (values.size() != nodes * N) assign_on_huge_pages(values, nodes * N, Real(0));
-  }
-  const Real* data() const { return values.data(); }
-  // Packs `count` consecutive nodes from `first` (v_old is read only when kOld).
-  void pack(long first, long count, const Vec<Dim>* v, const Vec<Dim>* v_old) {
-    for (long i = first; i < first + count; ++i) {
-      Real* r = &values[i * N];
-      for (int a = 0; a < Dim; ++a) {
-        r[a] = v[i][a];
-        if constexpr (kOld) r[old + a] = v_old[i][a];
-      }
-    }
-  }
-};
 
 // G2P sums over the stencil: v = sum w v_i, B = sum w v_i (x_i - x_p)^T,
 // G = sum v_i grad w^T, v_old = sum w v_i_old; and, for kernels whose D_p differs
