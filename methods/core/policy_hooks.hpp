@@ -10,6 +10,12 @@
 //   Gather gather_from(sums)                     or, with TensorTerms::nodal,
 //   void gather_from(sums, Gather&)              after the stencil's velocity rows
 //                                                were copied to Gather::v_data().
+// A policy may keep values per particle from P2G to the G2P of the same step
+// (PolyPIC's modes: the particles have not moved in between), declaring
+//   struct Kept;                                        one per particle, held by the solver
+//   Source prepare(P, p, tauV, stencil, Kept*)          P2G writes it
+//   Gather begin_gather(stencil, x_p, const Kept*)      G2P begins from it (null:
+//                                                       nothing kept this step)
 //   void finish_rows(rows, stencil, P, p, dt)    G2P's finish straight from the
 //                                                stencil sums in registers
 //                                                (TensorTransfer::Partial), declared
@@ -38,6 +44,41 @@ auto prepare_source(const Policy& policy, const Particles<Dim>& P, int p, const 
     return policy.prepare(P, p, tauV, st);
   } else {
     return policy.prepare(P, p, tauV);
+  }
+}
+
+// Whether the policy keeps values from P2G to G2P (Policy::Kept), and their type
+// (an empty one where it keeps none).
+// (A policy that keeps nothing in some dimensions declares Kept as NothingKept there.)
+struct NothingKept {};
+template <class Policy>
+constexpr bool keeps_from_p2g = [] {
+  if constexpr (requires { typename Policy::Kept; }) {
+    return !std::is_same_v<typename Policy::Kept, NothingKept>;
+  } else {
+    return false;
+  }
+}();
+template <class Policy>
+struct KeptType {
+  using type = NothingKept;
+};
+template <class Policy>
+requires keeps_from_p2g<Policy>
+struct KeptType<Policy> {
+  using type = typename Policy::Kept;
+};
+template <class Policy>
+using KeptOf = typename KeptType<Policy>::type;
+
+// prepare_source, recording what the policy keeps for G2P into *kept.
+template <class Policy, int Dim, class Kernel>
+auto prepare_source(const Policy& policy, const Particles<Dim>& P, int p, const Mat<Dim>& tauV,
+                    const Stencil<Dim, Kernel>& st, KeptOf<Policy>* kept) {
+  if constexpr (keeps_from_p2g<Policy>) {
+    return policy.prepare(P, p, tauV, st, kept);
+  } else {
+    return prepare_source(policy, P, p, tauV, st);
   }
 }
 

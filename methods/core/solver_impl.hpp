@@ -81,6 +81,8 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   using Base::unpack_and_drain;
   using Base::unpack_and_keep;
   using Base::v_rows_;
+  // The policy keeps values per particle from P2G to G2P (core/policy_hooks.hpp).
+  static constexpr bool kKeeps = keeps_from_p2g<Policy>;
   // Particles whose stencils G2P computes together (for_each_in_run).
   static constexpr int kRun = 8;
   // P2G takes the policy's FoldedForm (core/tensor_transfer.hpp) where the sums
@@ -100,6 +102,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     tauV_.assign(s.particles.size(), Mat<Dim>::Zero());  // written: the pages touched now
     sums_.resize(s.grid.size());
     if constexpr (kTensorPath) rows_.resize(s.grid.size());
+    if constexpr (kKeeps) kept_.resize(s.particles.size());
     v_rows_.resize(s.grid.size());
     this->prepare_stages(s);
   }
@@ -110,6 +113,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
     bin(s);
+    keep_from_scatter(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
     // The body force decided once: a possible call inside the particle's
     // scatter kept its form on the stack (perf: store-forwarding stalls).
@@ -194,6 +198,8 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     P.use_transfer_state(kTransferState);
     if constexpr (kTensorPath) pack_velocities(rows_, g, g.v.data(), g.v_old.data());
     const long n = static_cast<long>(P.size());
+    // What the policy kept from this step's scatter, if one ran since the last G2P.
+    const bool kept = std::exchange(kept_fresh_, false) && kept_.size() == P.size();
     Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min, v2_max = 0;
     long non_finite = n, outside = n;
     const Vec<Dim> lo = g.geo.lo, hi = g.geo.hi();  // the closed box of GridGeometry::contains
@@ -275,6 +281,8 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
                   typename Policy::Gather gather = [&]() MPMTB_INLINE_LAMBDA {
                     if constexpr (kTensorPath && !kNodalGather) {
                       return tensor_gather(policy, st, g.geo, rows_.data());
+                    } else if constexpr (kKeeps) {
+                      return policy.begin_gather(st, P.x[p], kept ? &kept_[p] : nullptr);
                     } else {
                       return begin_gather(policy, st);
                     }
@@ -332,6 +340,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     s.particles.use_transfer_state(kTransferState);
     clear_active_box(s.grid);
     bin(s);
+    keep_from_scatter(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
     blocks_.for_each_coloured(s, [&](int p) { scatter_particle<false>(s, policy, p, 0); });
     if constexpr (kTensorPath) {
@@ -341,6 +350,13 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   }
 
  private:
+  // The scatter that follows writes the policy's kept values of every particle.
+  void keep_from_scatter(const State<Dim>& s) {
+    if constexpr (kKeeps) {
+      kept_.resize(s.particles.size());
+      kept_fresh_ = true;
+    }
+  }
   // f(p, stencil of p) for p = first, ..., first + count - 1 (count <= kRun),
   // with the stencils computed first, back to back: a stencil is a long chain
   // of dependent operations from x_p to the first row's address, which the
@@ -365,7 +381,13 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
     const StencilT st(P.x[p], P.F[p], g.geo);
-    const auto src = prepare_source(policy, P, p, tauV_[p], st);  // core/policy_hooks.hpp
+    const auto src = [&]() MPMTB_INLINE_LAMBDA {  // core/policy_hooks.hpp
+      if constexpr (kKeeps) {
+        return prepare_source(policy, P, p, tauV_[p], st, &kept_[p]);
+      } else {
+        return prepare_source(policy, P, p, tauV_[p], st);
+      }
+    }();
     Real* m = g.m.data();
     Vec<Dim>* mom = g.p.data();
     Vec<Dim>* f = g.f.data();
@@ -477,6 +499,10 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   std::vector<Vec<Dim>> q_field_, q_sum_, q_particle_;
   std::vector<Real> q_mass_;
   NodeSums<Dim, true> q_sums_;  // the scatter's (m, m u) rows, zero between scatters
+  // The policy's values kept from the last scatter for G2P, and whether they
+  // are that scatter's (no G2P since).
+  std::vector<KeptOf<Policy>> kept_;
+  bool kept_fresh_ = false;
 };
 
 template <int Dim, class Kernel, class Transfer>
