@@ -73,8 +73,9 @@ using KeptOf = typename KeptType<Policy>::type;
 
 // prepare_source, recording what the policy keeps for G2P into *kept.
 template <class Policy, int Dim, class Kernel>
-auto prepare_source(const Policy& policy, const Particles<Dim>& P, int p, const Mat<Dim>& tauV,
-                    const Stencil<Dim, Kernel>& st, KeptOf<Policy>* kept) {
+MPMTB_INLINE inline auto prepare_source(const Policy& policy, const Particles<Dim>& P, int p,
+                                        const Mat<Dim>& tauV, const Stencil<Dim, Kernel>& st,
+                                        KeptOf<Policy>* kept) {
   if constexpr (keeps_from_p2g<Policy>) {
     return policy.prepare(P, p, tauV, st, kept);
   } else {

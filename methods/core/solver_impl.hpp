@@ -350,11 +350,31 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   }
 
  private:
-  // The scatter that follows writes the policy's kept values of every particle.
+  // The scatter that follows writes the policy's kept values of every particle,
+  // or reads them from a pass of their own before it, two particles at a time,
+  // where the policy has one (keep_modes: PolyPIC's modes in 1D and 2D).
   void keep_from_scatter(const State<Dim>& s) {
     if constexpr (kKeeps) {
-      kept_.resize(s.particles.size());
+      const Particles<Dim>& P = s.particles;
+      const long n = static_cast<long>(P.size());
+      kept_.resize(n);
       kept_fresh_ = true;
+      const Policy policy(transfer_params_, s.grid.geo.dx);
+      if constexpr (requires(KeptOf<Policy> & k, const StencilT& st) {
+                      policy.keep_modes(st, P.x[0], k, st, P.x[0], k);
+                    }) {
+        const auto stencil = [&](long p) MPMTB_INLINE_LAMBDA {
+          return StencilT(P.x[p], this->domain_F(P, p), s.grid.geo);
+        };
+#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
+        for (long a = 0; a < n - 1; a += 2) {
+          policy.keep_modes(stencil(a), P.x[a], kept_[a], stencil(a + 1), P.x[a + 1], kept_[a + 1]);
+        }
+        if (n % 2) {  // the last one paired with itself
+          const StencilT st = stencil(n - 1);
+          policy.keep_modes(st, P.x[n - 1], kept_[n - 1], st, P.x[n - 1], kept_[n - 1]);
+        }
+      }
     }
   }
   // f(p, stencil of p) for p = first, ..., first + count - 1 (count <= kRun),
