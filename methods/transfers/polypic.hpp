@@ -79,7 +79,7 @@ struct PolyModes {
     build_lanes(st.wk, st.dk, dx);
   }
   // The same from the weights w_a(k) and offsets (x_i - x_p)_a of node k, lane
-  // by lane: lanes hold axes, of one particle or of two (build_pair).
+  // by lane: lanes hold axes, of one particle or of two (keep_pair).
   MPMTB_INLINE void build_lanes(const AxisPack (&w)[S], const AxisPack (&d)[S], Real dx) {
     using Lanes = AxisPack;
     inv_dx = 1 / dx;
