@@ -380,15 +380,9 @@ class PolypicPolicy {
     Source s;
     s.m = P.m[p];
     s.tauV = tauV;
-    if constexpr (kKeepPass) {
-      if (kept && kept->x == P.x[p]) {
-        s.modes.restore(kept->modes);  // the solver's pass before P2G (keep_modes)
-      } else {
-        s.modes.build(st, dx_);
-        if (kept) s.modes.keep(kept->modes), kept->x = P.x[p];
-      }
-    } else {
-      s.modes.build(st, dx_);
+    // Restored where the solver's pass before P2G (keep_modes) recorded them;
+    // without that pass a record is the last step's, and is written anew.
+    if (!modes_at(s.modes, st, P.x[p], kKeepPass ? kept : nullptr)) {
       if constexpr (kKeepsModes) {
         if (kept) s.modes.keep(kept->modes), kept->x = P.x[p];
       }
@@ -458,7 +452,7 @@ class PolypicPolicy {
   // chain of dependent operations, and two particles share one.
   void keep_modes(const Stencil<Dim, Kernel>& a, const V& xa, Kept& kept_a,
                   const Stencil<Dim, Kernel>& b, const V& xb, Kept& kept_b) const
-      requires(kKeepsModes&& S >= 4) {
+      requires(kKeepPass) {
     Modes::keep_pair(a, b, dx_, kept_a.modes, kept_b.modes);
     kept_a.x = xa, kept_b.x = xb;
   }
@@ -467,14 +461,22 @@ class PolypicPolicy {
   // dependent operations, was a quarter of a 2D cubic step.
   Gather begin_gather(const Stencil<Dim, Kernel>& st, const V& x, const Kept* kept) const {
     Gather g;
+    modes_at(g.modes, st, x, kept);
+    return g;
+  }
+  // The modes at the stencil st of a particle at x: restored from `kept` where it
+  // was recorded at x (the caller passes only a record of this step), else built.
+  // True where restored.
+  MPMTB_INLINE bool modes_at(Modes& modes, const Stencil<Dim, Kernel>& st, const V& x,
+                             const Kept* kept) const {
     if constexpr (kKeepsModes) {
       if (kept && kept->x == x) {
-        g.modes.restore(kept->modes);
-        return g;
+        modes.restore(kept->modes);
+        return true;
       }
     }
-    g.modes.build(st, dx_);
-    return g;
+    modes.build(st, dx_);
+    return false;
   }
   static constexpr TensorTerms gather_terms{.gradient = true, .nodal = true};
   // The sums have filled g.v_rows (core/policy_hooks.hpp: tensor_gather).
