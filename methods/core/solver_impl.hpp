@@ -13,6 +13,7 @@
 #include <utility>
 
 #include "core/combinations.hpp"
+#include "core/particle_check.hpp"
 #include "core/policy_hooks.hpp"
 #include "core/solver.hpp"
 #include "core/solver_stages.hpp"
@@ -203,26 +204,9 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     Real J_min = std::numeric_limits<Real>::infinity(), J_max = -J_min, v2_max = 0;
     long non_finite = n, outside = n;
     const Vec<Dim> lo = g.geo.lo, hi = g.geo.hi();  // the closed box of GridGeometry::contains
-    // Failure detection, fused into this loop so that it costs nothing extra:
-    // the squared speed (one square root per step, below), and the box test
-    // first, which only a non-finite or escaped position fails. It runs one
-    // particle behind the transfer: read right after the finish wrote them, F,
-    // v and x came back through store forwarding from the finish's wider
-    // vector stores, which stalled (perf: a sixth of G2P on det F's loads).
-    const auto check = [&](long p, Real& J_lo, Real& J_hi, Real& v2_hi, long& bad,
-                           long& out) MPMTB_INLINE_LAMBDA {
-      const Real J = P.F[p].determinant();
-      J_lo = std::min(J_lo, J);
-      J_hi = std::max(J_hi, J);
-      const Real v2 = P.v[p].squaredNorm();
-      v2_hi = std::max(v2_hi, v2);
-      const bool inside = ((P.x[p].array() >= lo.array()) && (P.x[p].array() <= hi.array())).all();
-      if (!std::isfinite(J) || !std::isfinite(v2) || (!inside && !P.x[p].allFinite())) {
-        bad = std::min(bad, p);
-      } else if (!inside) {
-        out = std::min(out, p);
-      }
-    };
+    // Failure detection (core/particle_check.hpp): det F, the squared speed (one
+    // square root per step, below) and the box test, over each chunk of particles
+    // once it is gathered (its values still in the core's first-level cache).
     // Contiguous shares of the particles, sized by the threads' speeds in the
     // last G2P (core/thread_split.hpp).
     gather_split_.open();
@@ -250,9 +234,9 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
         first = n * t / threads, last = n * (t + 1) / threads;
         return !std::exchange(taken_alone, true) && first < last;
       };
+      ParticleCheck<Dim> checked(lo, hi, n);
       while (take()) {
         gathered += last - first;
-        long previous = -1;  // this thread's last particle, not yet checked
         for (long p0 = first; p0 < last; p0 += kRun) {
           for_each_in_run(
               P, g.geo, p0, std::min<long>(kRun, last - p0),
@@ -299,12 +283,14 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
                     policy.finish(gather, P, static_cast<int>(p), dt);
                   });
                 }
-                if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
-                previous = p;
               });
         }
-        if (previous >= 0) check(previous, J_min, J_max, v2_max, non_finite, outside);
+        checked.add(P, first, last - first);
       }
+      J_min = std::min(J_min, checked.J_min()), J_max = std::max(J_max, checked.J_max());
+      v2_max = std::max(v2_max, checked.v2_max());
+      non_finite = std::min(non_finite, checked.first_non_finite());
+      outside = std::min(outside, checked.first_outside());
       gather_split_.record(t, gathered, omp_get_wtime() - start);
     }
     gather_split_.close(threads_used);
