@@ -113,6 +113,33 @@ struct NodeBox {
       f(first, static_cast<long>(count));
     }
   }
+  // f(first, count) for every run of nodes along the last axis that lies in
+  // this box but not in `inner`, one after the other.
+  template <class F>
+  void for_each_row_outside(const NodeBox& inner, const std::array<long, Dim>& strides,
+                            F&& f) const {
+    const long n = rows();
+    const int lo_last = lo[Dim - 1], hi_last = hi[Dim - 1];
+    for (long r = 0; r < n; ++r) {
+      const auto [first, count] = row(r, strides);
+      bool leading_inside = true;  // the row's indices on the leading axes lie in inner
+      long rest = r;
+      for (int a = Dim - 2; a >= 0; --a) {
+        const long extent = hi[a] - lo[a] + 1;
+        const int index = lo[a] + static_cast<int>(rest % extent);
+        rest /= extent;
+        leading_inside = leading_inside && index >= inner.lo[a] && index <= inner.hi[a];
+      }
+      const int in_lo = std::max(lo_last, inner.lo[Dim - 1]);
+      const int in_hi = std::min(hi_last, inner.hi[Dim - 1]);
+      if (!leading_inside || in_lo > in_hi) {
+        f(first, static_cast<long>(count));
+        continue;
+      }
+      if (in_lo > lo_last) f(first, static_cast<long>(in_lo - lo_last));
+      if (in_hi < hi_last) f(first + (in_hi + 1 - lo_last), static_cast<long>(hi_last - in_hi));
+    }
+  }
   // f(node) for every node, in parallel over the rows.
   template <class F>
   void for_each_node(const std::array<long, Dim>& strides, F&& f) const {

@@ -72,6 +72,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   using Base::bin;
   using Base::blocks_;
   using Base::clear_active_box;
+  using Base::clear_for_unpack;
   using Base::compute_stresses;
   using Base::for_each_active_node;
   using Base::for_each_active_row;
@@ -112,8 +113,14 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     this->forget_start_F();
     compute_stresses(s);
     s.particles.use_transfer_state(kTransferState);
-    clear_active_box(s.grid);
-    bin(s);
+    if constexpr (kTensorPath) {
+      const NodeBox<Dim> before = s.grid.active;
+      bin(s);
+      clear_for_unpack(s.grid, before);
+    } else {
+      clear_active_box(s.grid);
+      bin(s);
+    }
     keep_from_scatter(s);
     const Policy policy(transfer_params_, s.grid.geo.dx);
     // The body force decided once: a possible call inside the particle's
@@ -138,7 +145,10 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     const bool has_gravity = gravity != Vec<Dim>::Zero();
     const bool folds = s.walls.may_fold(g);
     const bool gravity_in_update = has_gravity && !folds;
-    if (has_gravity && folds) for_each_active_node(g, [&](long i) { g.f[i] += g.m[i] * gravity; });
+    if (has_gravity && folds) {
+      for_each_active_node(g, [&](long i) { g.f[i] += g.m[i] * gravity; });
+      this->f_written_ = true;
+    }
     if (folds) s.walls.fold(g);
     Real rx = 0, ry = 0, rz = 0;  // reaction of the pinned nodes
 #pragma omp parallel for schedule(static) reduction(+ : rx, ry, rz) if (parallel)
@@ -428,6 +438,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
       st.for_each_node(g.geo, [&](long node, Real w, const Vec<Dim>&, const Vec<Dim>&) {
         if (w > 0) g.pinned[node] = 1;
       });
+      this->pinned_written_.store(true, std::memory_order_relaxed);
     }
   }
 

@@ -39,6 +39,30 @@ void SolverStages<Dim, Kernel, kFold>::clear_active_box(Grid<Dim>& g) {
 }
 
 template <int Dim, class Kernel, bool kFold>
+void SolverStages<Dim, Kernel, kFold>::clear_for_unpack(Grid<Dim>& g, const NodeBox<Dim>& before) {
+  sums_.resize(g.size());
+  const bool clear_sums = std::exchange(sums_kept_, false);
+  const auto strides = g.geo.strides();
+  before.for_each_row_outside(g.active, strides, [&](long first, long count) {
+    std::fill_n(g.m.begin() + first, count, Real(0));
+    std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
+    std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
+  });
+  // Over the old box (outside it every field is zero already).
+  const bool clear_f = kFold && std::exchange(f_written_, false);
+  const bool clear_pinned = pinned_written_.exchange(false, std::memory_order_relaxed);
+  if (!clear_f && !clear_pinned && !clear_sums) return;
+  before.for_each_row(strides, [&](long first, long count) {
+    if (clear_f) std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
+    if (clear_pinned) std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
+    if (clear_sums) sums_.clear(first, count);
+  });
+}
+
+template <int Dim, class Kernel, bool kFold>
 void SolverStages<Dim, Kernel, kFold>::bin(State<Dim>& s) {
   blocks_.bin(s);
 }
@@ -175,6 +199,7 @@ void SolverStages<Dim, Kernel, kFold>::instantiate(SolverStages& self, State<Dim
   self.S::prepare_stages(s);
   self.S::compute_stresses(s);
   self.S::clear_active_box(s.grid);
+  self.S::clear_for_unpack(s.grid, s.grid.active);
   self.S::bin(s);
   self.S::unpack_and_drain(s.grid);
   self.S::unpack_and_keep(s.grid);
