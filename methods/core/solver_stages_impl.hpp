@@ -21,6 +21,17 @@ void SolverStages<Dim, Kernel, kFold>::compute_stresses(const State<Dim>& s) {
   }
 }
 
+// Every nodal field of the `count` nodes from `first` zeroed.
+template <int Dim>
+void zero_nodes(Grid<Dim>& g, long first, long count) {
+  std::fill_n(g.m.begin() + first, count, Real(0));
+  std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
+  std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
+  std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
+  std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
+  std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
+}
+
 // The scatter's sums are zero outside the calls that fill and drain them, but
 // for those that scatter_momentum kept and no scatter_forces drained (musl).
 template <int Dim, class Kernel, bool kFold>
@@ -28,12 +39,7 @@ void SolverStages<Dim, Kernel, kFold>::clear_active_box(Grid<Dim>& g) {
   sums_.resize(g.size());
   const bool clear_sums = std::exchange(sums_kept_, false);
   for_each_active_row(g, [&](long first, long count) {
-    std::fill_n(g.m.begin() + first, count, Real(0));
-    std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
+    zero_nodes(g, first, count);
     if (clear_sums) sums_.clear(first, count);
   });
 }
@@ -43,14 +49,8 @@ void SolverStages<Dim, Kernel, kFold>::clear_for_unpack(Grid<Dim>& g, const Node
   sums_.resize(g.size());
   const bool clear_sums = std::exchange(sums_kept_, false);
   const auto strides = g.geo.strides();
-  before.for_each_row_outside(g.active, strides, [&](long first, long count) {
-    std::fill_n(g.m.begin() + first, count, Real(0));
-    std::fill_n(g.p.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.f.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.v.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.v_old.begin() + first, count, Vec<Dim>::Zero());
-    std::fill_n(g.pinned.begin() + first, count, std::uint8_t{0});
-  });
+  before.for_each_row_outside(g.active, strides,
+                              [&](long first, long count) { zero_nodes(g, first, count); });
   // Over the old box (outside it every field is zero already).
   const bool clear_f = kFold && std::exchange(f_written_, false);
   const bool clear_pinned = pinned_written_.exchange(false, std::memory_order_relaxed);
