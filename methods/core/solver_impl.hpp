@@ -397,7 +397,10 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     const Particles<Dim>& P = s.particles;
     Grid<Dim>& g = s.grid;
     const StencilT st(P.x[p], P.F[p], g.geo);
-    const auto src = [&]() MPMTB_INLINE_LAMBDA {  // core/policy_hooks.hpp
+    // core/policy_hooks.hpp. The two cases spelled out: as one call (the record
+    // `kKeeps ? &kept_[p] : nullptr`), 2D PolyPIC's cubic scatter compiled
+    // otherwise and ran 0.94x-0.98x (18 rounds at 1 thread).
+    const auto src = [&]() MPMTB_INLINE_LAMBDA {
       if constexpr (kKeeps) {
         return prepare_source(policy, P, p, tauV_[p], st, &kept_[p]);
       } else {
