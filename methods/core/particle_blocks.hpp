@@ -241,8 +241,13 @@ class ParticleBlocks {
     }
   }
 
-  template <class Scatter>
-  void for_each_coloured(const State<Dim>& s, Scatter&& scatter) const {
+  // (The scatter above.) ahead(q) before each scatter(p), with the particle q
+  // the thread takes next, to fetch its records.
+  struct NothingAhead {
+    void operator()(int) const {}
+  };
+  template <class Scatter, class Ahead = NothingAhead>
+  void for_each_coloured(const State<Dim>& s, Scatter&& scatter, Ahead&& ahead = {}) const {
     const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
     const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
     split_.open();
@@ -269,8 +274,9 @@ class ParticleBlocks {
         };
         const auto from = share(t), to = share(t + 1);
         const double start = omp_get_wtime();
-        for (auto b = from; b != to; ++b) {
-          for (int k = *b; k < *(b + 1); ++k) scatter(block_order_[k]);
+        for (int k = *from; k < *to; ++k) {
+          if (k + 1 < *to) ahead(block_order_[k + 1]);
+          scatter(block_order_[k]);
         }
         busy += omp_get_wtime() - start;
         scattered += *to - *from;

@@ -4,6 +4,7 @@
 #pragma once
 
 #include <cmath>
+#include <type_traits>
 #if defined(__AVX__)
 #include <immintrin.h>
 #endif
@@ -67,19 +68,28 @@ typedef Real AxisPack __attribute__((vector_size(4 * sizeof(Real))));
 
 // The lanes' square roots: one vector instruction where the target has it
 // (correctly rounded, as std::sqrt; the lanes are never negative where used).
-// (A template, so that only the branch of the build's Real is compiled.)
+// (A template, so that only the branch of the build's Real is compiled; also for
+// registers twice as wide as an AxisPack: PolyModes::keep_pair in 3D.)
 template <class Pack = AxisPack>
 inline Pack axis_sqrt(Pack x) {
+  constexpr bool is_double = std::is_same_v<std::remove_cvref_t<decltype(x[0])>, double>;
+#if defined(__AVX512F__)
+  if constexpr (sizeof(Pack) == 64 && is_double) {
+    return reinterpret_cast<Pack>(_mm512_sqrt_pd(reinterpret_cast<__m512d>(x)));
+  }
+#endif
 #if defined(__AVX__)
-  if constexpr (sizeof(Pack) == 32) {
+  if constexpr (sizeof(Pack) == 32 && is_double) {
     return reinterpret_cast<Pack>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(x)));
-  } else {
+  } else if constexpr (sizeof(Pack) == 32) {
+    return reinterpret_cast<Pack>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
+  } else if constexpr (sizeof(Pack) == 16 && !is_double) {
     return reinterpret_cast<Pack>(_mm_sqrt_ps(reinterpret_cast<__m128>(x)));
   }
-#else
-  for (int a = 0; a < 4; ++a) x[a] = std::sqrt(x[a]);
-  return x;
 #endif
+  constexpr int lanes = sizeof(Pack) / sizeof(x[0]);
+  for (int a = 0; a < lanes; ++a) x[a] = std::sqrt(x[a]);
+  return x;
 }
 
 // Four int lanes, one per axis (AxisPack's lanes as integers).

@@ -42,18 +42,20 @@ namespace mpmtb {
 // u_k = (x_i - x_p)_a / dx the node offsets in cell units. The tensor products
 // s_r(i) = prod_a e_{r_a}(u_{i_a}) are then orthogonal under w_ip = prod_a w_a,
 // and their norms factor: sum_i w_ip s_r(i)^2 = prod_a norm(a, r_a).
-template <int Dim, int S>
+// Lanes: one register with a lane per axis (AxisPack), or one twice as wide
+// holding the axes of two particles (keep_pair in 3D).
+template <int Dim, int S, class Lanes = AxisPack>
 struct PolyModes {
   static constexpr int count = ipow(S, Dim);  // modes = stencil nodes
 
-  // Per mode n and node k, one AxisPack with axis a in lane a, as the stencil's
+  // Per mode n and node k, one register with axis a in lane a, as the stencil's
   // factors (the build runs all axes at once and stores whole registers):
-  AxisPack e_[S][S];      // e_n at node k
-  AxisPack norm_[S];      // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
-  AxisPack unit_[S][S];   // e_n / sqrt(norm) for n >= 1 (0 if dropped), e_0 = 1 (norm 1)
-  AxisPack wunit_[S][S];  // w_a(k) unit_n(k): the weight folded in (the transforms)
-  AxisPack root_norm_;    // sqrt(norm_1): e_1 = root_norm unit_1
-  AxisPack d0_;           // offset of node 0 per axis
+  Lanes e_[S][S];      // e_n at node k
+  Lanes norm_[S];      // sum_k w_a(k) e_n(u_k)^2; 0 for a dropped mode
+  Lanes unit_[S][S];   // e_n / sqrt(norm) for n >= 1 (0 if dropped), e_0 = 1 (norm 1)
+  Lanes wunit_[S][S];  // w_a(k) unit_n(k): the weight folded in (the transforms)
+  Lanes root_norm_;    // sqrt(norm_1): e_1 = root_norm unit_1
+  Lanes d0_;           // offset of node 0 per axis
   Real inv_dx;
   bool kept_only_ = false;  // restore(): only wunit_ and root_norm_ are set
 
@@ -80,8 +82,7 @@ struct PolyModes {
   }
   // The same from the weights w_a(k) and offsets (x_i - x_p)_a of node k, lane
   // by lane: lanes hold axes, of one particle or of two (keep_pair).
-  MPMTB_INLINE void build_lanes(const AxisPack (&w)[S], const AxisPack (&d)[S], Real dx) {
-    using Lanes = AxisPack;
+  MPMTB_INLINE void build_lanes(const Lanes (&w)[S], const Lanes (&d)[S], Real dx) {
     inv_dx = 1 / dx;
     const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
     Lanes u[S], power[S], q[S][S], inv_norm[S];
@@ -117,7 +118,7 @@ struct PolyModes {
     }
     for (int n = 0; n < S; ++n) {
       // The partition of unity makes e_0 = 1 a unit mode (sum_k w_a(k) = 1).
-      const Lanes inv_root = n == 0 ? 1 - zero : axis_sqrt(inv_norm[n]);
+      const Lanes inv_root = n == 0 ? 1 - zero : axis_sqrt<Lanes>(inv_norm[n]);
       for (int k = 0; k < S; ++k) {
         e_[n][k] = q[n][k];
         unit_[n][k] = q[n][k] * inv_root;
@@ -137,7 +138,9 @@ struct PolyModes {
     Real root_norm[Dim];
   };
   // From the lanes first .. first + Dim - 1 (a particle's axes).
-  MPMTB_INLINE void keep(Kept& k, int first = 0) const {
+  // (K: the Kept of any Lanes; keep_pair's build is wider than the record's user.)
+  template <class K>
+  MPMTB_INLINE void keep(K& k, int first = 0) const {
     for (int n = 0; n < S; ++n)
       for (int j = 0; j < S; ++j)
         for (int a = 0; a < Dim; ++a) k.wunit[n][j][a] = wunit_[n][j][first + a];
@@ -147,7 +150,7 @@ struct PolyModes {
   // padding lanes zero, as the build leaves them).
   MPMTB_INLINE void restore(const Kept& k) {
     const auto lanes = [](const Real* v) MPMTB_INLINE_LAMBDA {
-      AxisPack r{};
+      Lanes r{};
       for (int a = 0; a < Dim; ++a) r[a] = v[a];
       return r;
     };
@@ -156,27 +159,34 @@ struct PolyModes {
     root_norm_ = lanes(k.root_norm);
     kept_only_ = true;
   }
-  // The records (keep) of two particles' modes from one build: where two
-  // particles' axes fit in one AxisPack (1D, 2D), particle a's in the first Dim
-  // lanes, b's in the next. Every operation of the build is lane by lane, so
-  // each record is the one its particle's own build gives, bit for bit, at half
-  // the operations.
+  // The records (keep) of two particles' modes from one build: particle a's axes
+  // in the first Dim lanes, b's in the next (1D, 2D: both in one AxisPack), or
+  // in the second half of a register twice as wide (3D). Every operation of the
+  // build is lane by lane, so each record is the one its particle's own build
+  // gives, bit for bit, in one chain of dependent operations instead of two
+  // (the build is bound by that chain's latency, not by the operations).
   template <class Kernel>
   static void keep_pair(const Stencil<Dim, Kernel>& a, const Stencil<Dim, Kernel>& b, Real dx,
-                        Kept& kept_a, Kept& kept_b) requires(2 * Dim <= 4) {
+                        Kept& kept_a, Kept& kept_b) {
+    static_assert(std::is_same_v<Lanes, AxisPack>);
+    constexpr bool kOneRegister = 2 * Dim <= 4;
+    using Both =
+        std::conditional_t<kOneRegister, AxisPack, typename PackOf<2 * sizeof(AxisPack)>::type>;
     const auto pair = [](const AxisPack& x, const AxisPack& y) MPMTB_INLINE_LAMBDA {
       if constexpr (Dim == 1) {
         return __builtin_shufflevector(x, y, 0, 4, 2, 3);
-      } else {
+      } else if constexpr (Dim == 2) {
         return __builtin_shufflevector(x, y, 0, 1, 4, 5);
+      } else {
+        return __builtin_shufflevector(x, y, 0, 1, 2, 3, 4, 5, 6, 7);
       }
     };
-    AxisPack w[S], d[S];
+    Both w[S], d[S];
     for (int k = 0; k < S; ++k) w[k] = pair(a.wk[k], b.wk[k]), d[k] = pair(a.dk[k], b.dk[k]);
-    PolyModes both;
+    PolyModes<Dim, S, Both> both;
     both.build_lanes(w, d, dx);
     both.keep(kept_a, 0);
-    both.keep(kept_b, Dim);
+    both.keep(kept_b, kOneRegister ? Dim : 4);
   }
 
   // The stencil index (last axis fastest, as Stencil::for_each_node) of the node
@@ -356,15 +366,17 @@ class PolypicPolicy {
     ScatterRow nodes[kModes];  // w_ip m_p v_p(x_i): ScatterForm::nodal
   };
   // Kept per particle from P2G to the G2P of the same step (core/policy_hooks.hpp):
-  // the modes G2P reads, and the position they were built at. In 1D and 2D only:
-  // in 3D the record (S^2 Dim values) cost about what the build it spares did
-  // (3D block at 1 thread: cubic 0.94-1.01x, quadratic 0.99-1.02x; 2D cubic
-  // 1.19-1.25x, quadratic 1.23-1.27x).
-  static constexpr bool kKeepsModes = Dim <= 2;
+  // the modes G2P reads, and the position they were built at. In 2D: cubic
+  // 1.19-1.25x, quadratic 1.23-1.27x. In 3D the record (S^2 Dim values) cost
+  // about what the one build it spared did (block at 1 thread: cubic 0.94-1.01x,
+  // quadratic 0.99-1.02x), so it is kept only with the pass below.
+  static constexpr bool kKeepsModes = Dim <= 2 || S >= 4;
   // With 4 nodes per axis (cubic B-spline, cpGIMP) a pass before P2G builds the
   // modes of two particles at once (keep_modes) and P2G restores them too: 2D
-  // cubic 1.07-1.33x, cpGIMP 1.17-1.26x (5 rounds at 1 thread). With 3 the build
-  // is cheaper than the pass's stencils and records: quadratic 0.82-0.93x.
+  // cubic 1.07-1.33x, cpGIMP 1.17-1.26x (5 rounds at 1 thread); 3D cubic, with
+  // P2G fetching the records ahead (core/solver_impl.hpp), 1.19x at 1 thread and
+  // 1.15x at 2 (5 rounds). With 3 the build is cheaper than the pass's stencils
+  // and records: 2D quadratic 0.82-0.93x.
   static constexpr bool kKeepPass = kKeepsModes && S >= 4;
   struct KeptModes {
     typename Modes::Kept modes;

@@ -57,9 +57,10 @@ TEST(PolypicModes, OrthogonalUnderTheWeights) {
 }
 
 // Two particles' modes from one build, their axes side by side in the lanes
-// (PolyModes::keep_pair, the pass before P2G in 1D and 2D), are each particle's
-// own build, bit for bit: also where a mode is dropped (a particle on a node, or
-// half-way between two with the quadratic B-spline), in one of the two or both.
+// (PolyModes::keep_pair, the pass before P2G; in 3D in a register twice as wide
+// as one particle's), are each particle's own build, bit for bit: also where a
+// mode is dropped (a particle on a node, or half-way between two with the
+// quadratic B-spline), in one of the two or both.
 template <int Dim, class Kernel>
 void check_pair_build() {
   constexpr int S = Kernel::support;
@@ -100,6 +101,9 @@ TEST(PolypicModes, PairBuildIsEachParticlesOwn) {
   check_pair_build<2, QuadraticKernel>();
   check_pair_build<2, CubicKernel>();
   check_pair_build<2, CpGimpKernel>();
+  check_pair_build<3, QuadraticKernel>();
+  check_pair_build<3, CubicKernel>();
+  check_pair_build<3, CpGimpKernel>();
 }
 
 // The weighted transforms give the same bits whatever the rows' width: rows of 2
