@@ -254,6 +254,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
           for_each_in_run(
               P, g.geo, p0, std::min<long>(kRun, last - p0),
               [&](long p, const StencilT& st) MPMTB_INLINE_LAMBDA {
+                if (p + 1 < last) prefetch_particle_state(P, p + 1);
                 // kDeform = false: the finish may update F, the motion part keeps it.
                 const auto finish = [&](auto&& finish_particle) MPMTB_INLINE_LAMBDA {
                   if constexpr (kDeform) {
@@ -376,13 +377,15 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
       }
     }
   }
-  // A particle's long records fetched one particle ahead of P2G, which takes the
-  // particles in the blocks' order, not in memory's, so the hardware's
-  // prefetcher does not follow: PolyPIC's higher modes (180 values in 3D with the
-  // cubic B-spline) and the modes kept for it by the pass before P2G. Records of
-  // a few lines are left to the hardware. 3D PolyPIC at 1 thread (5 rounds):
-  // cubic 1.10x, quadratic 1.02x. Always inlined: out of line, GCC took the
-  // function, having only prefetches, for one without effects and dropped it.
+  // A particle's long records fetched one particle ahead, in P2G and G2P:
+  // PolyPIC's higher modes (180 values in 3D with the cubic B-spline) and the
+  // modes kept by the pass before P2G. P2G takes the particles in the blocks'
+  // order, not in memory's, which the hardware's prefetcher does not follow; in
+  // G2P, in memory's order, it does not keep up with records this long either.
+  // Records of a few lines are left to the hardware. 3D PolyPIC at 1 thread (5-7
+  // rounds): cubic 1.10x from P2G's, 1.10x more from G2P's; quadratic 1.02x
+  // from each. Always inlined: out of line, GCC took the function, having only
+  // prefetches, for one without effects and dropped it.
   static constexpr int kFetchAheadBytes = 256;
   MPMTB_INLINE void prefetch_particle_state(const Particles<Dim>& P, long p) const {
     const auto fetch = [](const void* first, int bytes) MPMTB_INLINE_LAMBDA {
