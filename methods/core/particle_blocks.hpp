@@ -241,8 +241,8 @@ class ParticleBlocks {
     }
   }
 
-  // (The scatter above.) ahead(q) before each scatter(p), with the particle q
-  // the thread takes next, to fetch its records.
+  // The scatter above: scatter(p) for every particle of the last bin(); before
+  // each, ahead(q) with the particle q the thread takes next (to fetch its records).
   struct NothingAhead {
     void operator()(int) const {}
   };

@@ -66,30 +66,42 @@ constexpr bool kernel_particle_inertia = [] {
 // One SIMD value with a lane per axis (up to 3 axes and a padding lane).
 typedef Real AxisPack __attribute__((vector_size(4 * sizeof(Real))));
 
-// The lanes' square roots: one vector instruction where the target has it
-// (correctly rounded, as std::sqrt; the lanes are never negative where used).
+// The lanes' square roots, in place: one vector instruction where the target has
+// it (correctly rounded, as std::sqrt; the lanes are never negative where used).
 // (A template, so that only the branch of the build's Real is compiled; also for
-// registers twice as wide as an AxisPack: PolyModes::keep_pair in 3D.)
+// registers twice as wide as an AxisPack, PolyModes::keep_pair in 3D, which are
+// never passed by value: GCC warns of their ABI on targets without AVX-512.)
 template <class Pack = AxisPack>
-inline Pack axis_sqrt(Pack x) {
+inline void axis_sqrt_in_place(Pack& x) {
   constexpr bool is_double = std::is_same_v<std::remove_cvref_t<decltype(x[0])>, double>;
 #if defined(__AVX512F__)
   if constexpr (sizeof(Pack) == 64 && is_double) {
-    return reinterpret_cast<Pack>(_mm512_sqrt_pd(reinterpret_cast<__m512d>(x)));
+    x = reinterpret_cast<Pack>(_mm512_sqrt_pd(reinterpret_cast<__m512d>(x)));
+    return;
+  }
+#elif defined(__AVX__)
+  if constexpr (sizeof(Pack) == 64 && is_double) {  // two AVX registers
+    auto lo = __builtin_shufflevector(x, x, 0, 1, 2, 3);
+    auto hi = __builtin_shufflevector(x, x, 4, 5, 6, 7);
+    axis_sqrt_in_place(lo), axis_sqrt_in_place(hi);
+    x = __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+    return;
   }
 #endif
 #if defined(__AVX__)
   if constexpr (sizeof(Pack) == 32 && is_double) {
-    return reinterpret_cast<Pack>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(x)));
+    x = reinterpret_cast<Pack>(_mm256_sqrt_pd(reinterpret_cast<__m256d>(x)));
+    return;
   } else if constexpr (sizeof(Pack) == 32) {
-    return reinterpret_cast<Pack>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
+    x = reinterpret_cast<Pack>(_mm256_sqrt_ps(reinterpret_cast<__m256>(x)));
+    return;
   } else if constexpr (sizeof(Pack) == 16 && !is_double) {
-    return reinterpret_cast<Pack>(_mm_sqrt_ps(reinterpret_cast<__m128>(x)));
+    x = reinterpret_cast<Pack>(_mm_sqrt_ps(reinterpret_cast<__m128>(x)));
+    return;
   }
 #endif
   constexpr int lanes = sizeof(Pack) / sizeof(x[0]);
   for (int a = 0; a < lanes; ++a) x[a] = std::sqrt(x[a]);
-  return x;
 }
 
 // Four int lanes, one per axis (AxisPack's lanes as integers).

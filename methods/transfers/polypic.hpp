@@ -118,7 +118,8 @@ struct PolyModes {
     }
     for (int n = 0; n < S; ++n) {
       // The partition of unity makes e_0 = 1 a unit mode (sum_k w_a(k) = 1).
-      const Lanes inv_root = n == 0 ? 1 - zero : axis_sqrt<Lanes>(inv_norm[n]);
+      Lanes inv_root = 1 - zero;
+      if (n > 0) inv_root = inv_norm[n], axis_sqrt_in_place(inv_root);
       for (int k = 0; k < S; ++k) {
         e_[n][k] = q[n][k];
         unit_[n][k] = q[n][k] * inv_root;
@@ -172,17 +173,19 @@ struct PolyModes {
     constexpr bool kOneRegister = 2 * Dim <= 4;
     using Both =
         std::conditional_t<kOneRegister, AxisPack, typename PackOf<2 * sizeof(AxisPack)>::type>;
-    const auto pair = [](const AxisPack& x, const AxisPack& y) MPMTB_INLINE_LAMBDA {
+    // (Written through a reference: a 64-byte vector returned by value draws
+    // GCC's ABI warning on targets without AVX-512.)
+    const auto pair = [](const AxisPack& x, const AxisPack& y, Both& both) MPMTB_INLINE_LAMBDA {
       if constexpr (Dim == 1) {
-        return __builtin_shufflevector(x, y, 0, 4, 2, 3);
+        both = __builtin_shufflevector(x, y, 0, 4, 2, 3);
       } else if constexpr (Dim == 2) {
-        return __builtin_shufflevector(x, y, 0, 1, 4, 5);
+        both = __builtin_shufflevector(x, y, 0, 1, 4, 5);
       } else {
-        return __builtin_shufflevector(x, y, 0, 1, 2, 3, 4, 5, 6, 7);
+        both = __builtin_shufflevector(x, y, 0, 1, 2, 3, 4, 5, 6, 7);
       }
     };
     Both w[S], d[S];
-    for (int k = 0; k < S; ++k) w[k] = pair(a.wk[k], b.wk[k]), d[k] = pair(a.dk[k], b.dk[k]);
+    for (int k = 0; k < S; ++k) pair(a.wk[k], b.wk[k], w[k]), pair(a.dk[k], b.dk[k], d[k]);
     PolyModes<Dim, S, Both> both;
     both.build_lanes(w, d, dx);
     both.keep(kept_a, 0);
