@@ -248,6 +248,32 @@ class ParticleBlocks {
   };
   template <class Scatter, class Ahead = NothingAhead>
   void for_each_coloured(const State<Dim>& s, Scatter&& scatter, Ahead&& ahead = {}) const {
+    for_each_share(s, [&](int from, int to) MPMTB_INLINE_LAMBDA {
+      for (int k = from; k < to; ++k) {
+        if (k + 1 < to) ahead(block_order_[k + 1]);
+        scatter(block_order_[k]);
+      }
+    });
+  }
+  // The same a run of up to `run` particles at a time, in the same order:
+  // f(ids, count, next, next_count) with the run's particles ids[0] .. ids[count - 1]
+  // and the next run the thread takes, next[0] .. next[next_count - 1].
+  template <class Run>
+  void for_each_coloured_run(const State<Dim>& s, int run, Run&& f) const {
+    for_each_share(s, [&](int from, int to) MPMTB_INLINE_LAMBDA {
+      for (int k = from; k < to; k += run) {
+        const int count = std::min(run, to - k);
+        const int next_count = std::min(run, to - k - count);
+        f(block_order_.data() + k, count, block_order_.data() + k + count, next_count);
+      }
+    });
+  }
+
+ private:
+  // share(from, to) with each thread's share of each colour, the indices into
+  // block_order_ [from, to), the colours one after the other.
+  template <class Share>
+  void for_each_share(const State<Dim>& s, Share&& share_of) const {
     const bool parallel = static_cast<long>(s.particles.size()) >= kParallelMinimum;
     const int per_colour = static_cast<int>(block_start_.size() - 1) / kColours;
     split_.open();
@@ -274,10 +300,7 @@ class ParticleBlocks {
         };
         const auto from = share(t), to = share(t + 1);
         const double start = omp_get_wtime();
-        for (int k = *from; k < *to; ++k) {
-          if (k + 1 < *to) ahead(block_order_[k + 1]);
-          scatter(block_order_[k]);
-        }
+        share_of(*from, *to);
         busy += omp_get_wtime() - start;
         scattered += *to - *from;
 #pragma omp barrier
@@ -287,7 +310,6 @@ class ParticleBlocks {
     split_.close(threads_used);
   }
 
- private:
   // Blocks over the first two axes (one in 1D), 2^axes colours. (Blocks over
   // all three axes in 3D, 8 colours, measured 23 % slower on the 3D block at one
   // thread: each colour's scatter sweeps most of the grid's sums, twice as often.)

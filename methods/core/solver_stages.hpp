@@ -50,6 +50,10 @@ class SolverStages : public Stepper<Dim> {
 
   // V0_p tau_p of every particle, from the materials, into tauV_.
   [[gnu::noinline]] void compute_stresses(const State<Dim>& s);
+  // The particles P2G's scatter takes at a time (ParticleBlocks::for_each_coloured_run)
+  // after their stresses (State::kirchhoff_times_volume_of): one batch of the
+  // models' logarithms (ModelBase).
+  static constexpr int kStressRun = 64;
   // Zeroes every nodal field over the active box of the previous step: the grid
   // is zero everywhere before the scatter, at a cost that follows the particles.
   [[gnu::noinline]] void clear_active_box(Grid<Dim>& g);

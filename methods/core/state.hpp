@@ -1,6 +1,7 @@
 // Everything a step reads and writes: particles, grid, materials, boundary.
 #pragma once
 
+#include <algorithm>
 #include <functional>
 #include <memory>
 #include <span>
@@ -38,6 +39,31 @@ struct State {
     material_particles.assign(materials.size(), {});
     for (std::size_t p = 0; p < particles.size(); ++p) {
       material_particles[particles.material[p]].push_back(static_cast<int>(p));
+    }
+  }
+  // out[k] = V0_p tau_p for the particles p = ids[k], each from its material's
+  // model, serially (a run of P2G's scatter: core/solver_impl.hpp).
+  void kirchhoff_times_volume_of(std::span<const int> ids, Mat<Dim>* out) const {
+    if (ids.empty()) return;
+    const std::vector<int>& material = particles.material;
+    const int first = material[ids[0]];
+    if (std::all_of(ids.begin(), ids.end(), [&](int p) { return material[p] == first; })) {
+      materials[first]->kirchhoff_times_volume_of(particles, ids, out);
+      return;
+    }
+    // A run across materials (rare: where bodies meet): each material's
+    // particles of the run together.
+    std::vector<int> own, place;
+    std::vector<Mat<Dim>> own_out;
+    for (std::size_t m = 0; m < materials.size(); ++m) {
+      own.clear(), place.clear();
+      for (std::size_t k = 0; k < ids.size(); ++k) {
+        if (material[ids[k]] == static_cast<int>(m)) own.push_back(ids[k]), place.push_back(k);
+      }
+      if (own.empty()) continue;
+      own_out.resize(own.size());
+      materials[m]->kirchhoff_times_volume_of(particles, own, own_out.data());
+      for (std::size_t i = 0; i < own.size(); ++i) out[place[i]] = own_out[i];
     }
   }
   // Largest wave speed over the materials in their current state (snow

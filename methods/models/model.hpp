@@ -85,6 +85,11 @@ class ConstitutiveModel {
   // tauV[p] = V0_p * tau(F_p), tau = P F^T the Kirchhoff stress.
   virtual void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
                                       std::vector<Mat<Dim>>& tauV) const = 0;
+  // The same for a few particles, serially: out[k] = V0_p tau_p for p = ids[k]
+  // (P2G computes its particles' stresses a batch at a time, in the scatter's
+  // order, just before it scatters them: core/solver_impl.hpp).
+  virtual void kirchhoff_times_volume_of(const Particles<Dim>& particles, std::span<const int> ids,
+                                         Mat<Dim>* out) const = 0;
   // sum_p V0_p psi(F_p), summed in particle order (deterministic).
   virtual Real strain_energy(const Particles<Dim>& particles, std::span<const int> ids) const = 0;
   // Plastic or damage return map after F_p is updated; no-op for elasticity.
@@ -121,35 +126,17 @@ class ModelBase : public ConstitutiveModel<Dim> {
   }
   void kirchhoff_times_volume(const Particles<Dim>& particles, std::span<const int> ids,
                               std::vector<Mat<Dim>>& tauV) const override {
-    if constexpr (requires(const Mat<Dim>& F, const Real* q, Mat<Dim>& out) {
-                    self().tau_times_volume_given_log_and_power(F, 0, 1, q, 1, out);
-                  }) {
-      // A power of J too, exp(c ln J), batch-wise (damage's J^(2/3) in 3D).
-      for_each_with_log(particles, ids, [&](int p, Real logJ, Real power) {
-        self().tau_times_volume_given_log_and_power(
-            particles.F[p], logJ, power, particles.state_of(p), particles.V0[p], tauV[p]);
-      });
-    } else if constexpr (requires(const Mat<Dim>& F, const Real* q, Mat<Dim>& out) {
-                           self().tau_times_volume_given_log(F, 0, q, 1, out);
-                         }) {
-      for_each_with_log(particles, ids, [&](int p, Real logJ) {
-        self().tau_times_volume_given_log(particles.F[p], logJ, particles.state_of(p),
-                                          particles.V0[p], tauV[p]);
-      });
-    } else if constexpr (requires(const Mat<Dim>& F, const Real* q) {
-                           self().tau_given_log(F, 0, q);
-                         }) {
-      for_each_with_log(particles, ids, [&](int p, Real logJ) {
-        tauV[p] =
-            particles.V0[p] * self().tau_given_log(particles.F[p], logJ, particles.state_of(p));
-      });
-    } else {
-      const long n = static_cast<long>(ids.size());
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-      for (long i = 0; i < n; ++i) {
-        const int p = ids[i];
-        tauV[p] = particles.V0[p] * self().tau(particles.F[p], particles.state_of(p));
-      }
+    for_each_batch(static_cast<long>(ids.size()), [&](long first, int count) {
+      stress_batch(particles, &ids[first], count,
+                   [&](int k) MPMTB_INLINE_LAMBDA -> Mat<Dim>& { return tauV[ids[first + k]]; });
+    });
+  }
+  void kirchhoff_times_volume_of(const Particles<Dim>& particles, std::span<const int> ids,
+                                 Mat<Dim>* out) const override {
+    const int n = static_cast<int>(ids.size());
+    for (int first = 0; first < n; first += kLogBatch) {
+      stress_batch(particles, &ids[first], std::min(kLogBatch, n - first),
+                   [&](int k) MPMTB_INLINE_LAMBDA -> Mat<Dim>& { return out[first + k]; });
     }
   }
   void return_map(Particles<Dim>& particles, std::span<const int> ids, Real dt) const override {
@@ -202,43 +189,106 @@ class ModelBase : public ConstitutiveModel<Dim> {
   static constexpr long kLogChunk = 4;
   // f(p, ln det F_p) for every particle p of ids but those a skip screens out
   // (skip(ids, count, J, kept) writes det F and the ids of the particles kept
-  // of a batch, and returns their count), in parallel over
-  // batches of kLogBatch: each batch's logarithms first, in vector registers
-  // (core/batch_log.hpp), then f for its particles. For the
-  // models whose stress or return map needs ln J (tau_given_log,
-  // project_given_log). (batch_log's lanes are independent: a value's logarithm
-  // does not depend on the batch it is in.) An f that takes a third argument
-  // gets exp(Derived::kPowerOfLog ln det F_p) too (core/batch_exp.hpp).
+  // of a batch, and returns their count), in parallel over batches of
+  // kLogBatch: each batch's logarithms first, in vector registers
+  // (core/batch_log.hpp), then f for its particles. For the return maps that
+  // need ln J (project_given_log); the stress batches take with_log directly.
+  // (batch_log's lanes are independent: a value's logarithm does not depend on
+  // the batch it is in, so neither does a stress, which P2G computes in runs of
+  // its scatter's order: kirchhoff_times_volume_of.)
   struct NoSkip {};
   template <class F, class Skip = NoSkip>
   static void for_each_with_log(const Particles<Dim>& particles, std::span<const int> ids, F&& f,
                                 Skip&& skip = {}) {
-    constexpr bool skips = !std::is_same_v<std::decay_t<Skip>, NoSkip>;
-    const long n = static_cast<long>(ids.size());
+    for_each_batch(static_cast<long>(ids.size()), [&](long first, int count) {
+      with_log(
+          particles, &ids[first], count,
+          [&](int, int p, Real logJ, Real) MPMTB_INLINE_LAMBDA { f(p, logJ); }, skip);
+    });
+  }
+  // f(first, count) for each batch of kLogBatch of n particles, in parallel.
+  template <class F>
+  static void for_each_batch(long n, F&& f) {
     const long batches = (n + kLogBatch - 1) / kLogBatch;
     for_each_chunk_balanced(batches, kLogChunk, n >= kParallelMinimum, [&](long from, long to) {
       for (long b = from; b < to; ++b) {
-        const long first = b * kLogBatch;
-        int count = static_cast<int>(std::min<long>(kLogBatch, n - first));
-        Real J[kLogBatch], logJ[kLogBatch];
-        int kept[kLogBatch];
-        if constexpr (skips) {
-          count = skip(&ids[first], count, J, kept);  // det F and the ids kept
-        } else {
-          for (int k = 0; k < count; ++k) J[k] = particles.F[ids[first + k]].determinant();
-        }
-        batch_log(J, logJ, count);
-        if constexpr (std::is_invocable_v<F, int, Real, Real>) {
-          Real exponent[kLogBatch], power[kLogBatch];
-          for (int k = 0; k < count; ++k) exponent[k] = Derived::kPowerOfLog * logJ[k];
-          batch_exp(exponent, power, count);
-          for (int k = 0; k < count; ++k) f(skips ? kept[k] : ids[first + k], logJ[k], power[k]);
-        } else {
-          for (int k = 0; k < count; ++k) f(skips ? kept[k] : ids[first + k], logJ[k]);
-        }
+        f(b * kLogBatch, static_cast<int>(std::min<long>(kLogBatch, n - b * kLogBatch)));
       }
     });
   }
+  // One batch of for_each_with_log, serial: f(k, p, ln det F_p[, power]) for the
+  // particles p = ids[k], k < count <= kLogBatch (k counts the particles kept;
+  // power: exp(Derived::kPowerOfLog ln det F_p) with kPower, else 1).
+  template <bool kPower = false, class F, class Skip = NoSkip>
+  MPMTB_INLINE static void with_log(const Particles<Dim>& particles, const int* ids, int count,
+                                    F&& f, Skip&& skip = {}) {
+    constexpr bool skips = !std::is_same_v<std::decay_t<Skip>, NoSkip>;
+    // J zeroed: GCC cannot tell that the first `count` values, the only ones
+    // batch_log reads, are written (-Wmaybe-uninitialized); 8 stores a batch.
+    Real J[kLogBatch] = {}, logJ[kLogBatch];
+    int kept[kLogBatch];
+    if constexpr (skips) {
+      count = skip(ids, count, J, kept);  // det F and the ids kept
+    } else {
+      for (int k = 0; k < count; ++k) J[k] = particles.F[ids[k]].determinant();
+    }
+    batch_log(J, logJ, count);
+    if constexpr (kPower) {
+      Real exponent[kLogBatch] = {}, power[kLogBatch];  // zeroed as J
+      for (int k = 0; k < count; ++k) exponent[k] = Derived::kPowerOfLog * logJ[k];
+      batch_exp(exponent, power, count);
+      for (int k = 0; k < count; ++k) f(k, skips ? kept[k] : ids[k], logJ[k], power[k]);
+    } else {
+      for (int k = 0; k < count; ++k) f(k, skips ? kept[k] : ids[k], logJ[k], Real(1));
+    }
+  }
+  // out(k) = V0_p tau_p for the particles p = ids[k] of one batch (count <=
+  // kLogBatch), with the batch's logarithms where the formula takes them.
+  template <class Out>
+  MPMTB_INLINE void stress_batch(const Particles<Dim>& particles, const int* ids, int count,
+                                 Out&& out) const {
+    if constexpr (stress_takes_log()) {
+      with_log<stress_takes_power()>(particles, ids, count,
+                                     [&](int k, int p, Real logJ, Real power) MPMTB_INLINE_LAMBDA {
+                                       tau_times_volume(particles, p, logJ, power, out(k));
+                                     });
+    } else {
+      for (int k = 0; k < count; ++k) tau_times_volume(particles, ids[k], Real(0), Real(1), out(k));
+    }
+  }
+  // Which stress formula Derived has, the first of: V0 tau from ln J and
+  // exp(kPowerOfLog ln J); V0 tau from ln J; tau from ln J; tau from F alone.
+  static constexpr bool stress_takes_power() {
+    return requires(const Derived& d, const Mat<Dim>& F, const Real* q, Mat<Dim>& out) {
+      d.tau_times_volume_given_log_and_power(F, 0, 1, q, 1, out);
+    };
+  }
+  static constexpr bool stress_takes_log() {
+    return stress_takes_power() ||
+           requires(const Derived& d, const Mat<Dim>& F, const Real* q, Mat<Dim>& out) {
+      d.tau_times_volume_given_log(F, 0, q, 1, out);
+    }
+    || requires(const Derived& d, const Mat<Dim>& F, const Real* q) {
+      d.tau_given_log(F, 0, q);
+    };
+  }
+  // out = V0_p tau_p by that formula (logJ = ln det F_p and power its multiple's
+  // exponential where the formula takes them).
+  MPMTB_INLINE void tau_times_volume(const Particles<Dim>& particles, int p, Real logJ,
+                                     [[maybe_unused]] Real power, Mat<Dim>& out) const {
+    const Mat<Dim>& F = particles.F[p];
+    const Real* q = particles.state_of(p);
+    if constexpr (stress_takes_power()) {
+      self().tau_times_volume_given_log_and_power(F, logJ, power, q, particles.V0[p], out);
+    } else if constexpr (requires { self().tau_times_volume_given_log(F, logJ, q, 1, out); }) {
+      self().tau_times_volume_given_log(F, logJ, q, particles.V0[p], out);
+    } else if constexpr (stress_takes_log()) {
+      out = particles.V0[p] * self().tau_given_log(F, logJ, q);
+    } else {
+      out = particles.V0[p] * self().tau(F, q);
+    }
+  }
+
   const Derived& self() const {
     return static_cast<const Derived&>(*this);
   }

@@ -5,12 +5,18 @@
 // through the batch loop (no tau_given_log) must be V0 P F^T.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+#include <cmath>
+#include <map>
 #include <random>
 #include <span>
+#include <string>
 #include <vector>
 
 #include "core/particles.hpp"
+#include "core/state.hpp"
 #include "models/model.hpp"
+#include "models/registry.hpp"
 #include "support/random_matrices.hpp"
 
 namespace mpmtb {
@@ -92,6 +98,50 @@ TEST(ModelBase, StressPassOfAModelWithoutLogIsV0PFTransposed) {
   for (int p = 0; p < 100; ++p) {
     const Mat<3> expected = P.V0[p] * model.first_piola(P.F[p], nullptr) * P.F[p].transpose();
     EXPECT_LE((tauV[p] - expected).norm(), 1e-13 * expected.norm()) << "particle " << p;
+  }
+}
+
+// A run of P2G across materials (State::kirchhoff_times_volume_of): each
+// particle gets its own material's stress, the bits of that material's pass,
+// in the run's order. Three materials, the particles' materials mixed along the
+// run (and one material absent from it).
+TEST(ModelBase, RunAcrossMaterialsGivesEachParticleItsMaterialsStress) {
+  State<3> s;
+  const auto add_model = [&](const std::string& name, std::map<std::string, Real> values) {
+    Parameters p("materials." + name, values);
+    s.materials.push_back(make_model<3>(name, p));
+  };
+  add_model("neo-hookean", {{"E", 1e4}, {"nu", 0.3}, {"density", 1}});
+  add_model("damage", {{"E", 2e4}, {"nu", 0.25}, {"density", 2}, {"sigma_crit", 50}});
+  add_model("fixed-corotated", {{"E", 3e4}, {"nu", 0.2}, {"density", 3}});
+  add_model("linear-elastic", {{"E", 5e3}, {"nu", 0.3}, {"density", 1}});
+  std::mt19937 gen(11);
+  const int n = 90;
+  for (const auto& m : s.materials)
+    s.particles.state_size = std::max(s.particles.state_size, m->state_size());
+  for (int p = 0; p < n; ++p) {
+    const int material = p % 7 < 3 ? 0 : (p % 7 < 5 ? 1 : 2);  // never the fourth
+    s.particles.add(Vec<3>::Zero(), Vec<3>::Zero(), 1, Real(1) + p, material);
+    s.particles.F[p] = testing::RandomF<3>(gen);
+    s.materials[material]->initial_state(s.particles.state_of(p));
+  }
+  s.index_materials();
+  std::vector<Mat<3>> pass(n);
+  for (std::size_t m = 0; m < s.materials.size(); ++m)
+    s.materials[m]->kirchhoff_times_volume(s.particles, s.material_particles[m], pass);
+  std::vector<int> run(n);
+  for (int k = 0; k < n; ++k) run[k] = (k * 37) % n;  // a permutation: 37 and 90 coprime
+  std::vector<Mat<3>> out(n, Mat<3>::Constant(std::nan("")));
+  s.kirchhoff_times_volume_of(run, out.data());
+  for (int k = 0; k < n; ++k) {
+    EXPECT_TRUE(out[k] == pass[run[k]])
+        << "particle " << run[k] << " (material " << s.particles.material[run[k]] << ")";
+  }
+  // Another material's stress differs (the test tells the materials apart).
+  for (const int p : {3, 5}) {
+    Mat<3> other;
+    s.materials[0]->kirchhoff_times_volume_of(s.particles, std::span<const int>(&p, 1), &other);
+    EXPECT_FALSE(other == pass[p]) << "particle " << p;
   }
 }
 

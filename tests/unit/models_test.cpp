@@ -16,6 +16,7 @@
 #include <random>
 #include <regex>
 #include <set>
+#include <span>
 #include <string>
 #include <vector>
 
@@ -169,6 +170,39 @@ TEST_P(ModelConformance, BatchesMatchPerParticleFormulas) {
     EXPECT_NEAR(m.strain_energy(P, Ids(P.size())), energy, 1e-12 * (std::abs(energy) + kE));
     EXPECT_EQ(m.dissipated_energy(P, Ids(P.size())), 0.0)
         << "nothing dissipated before a return map";
+  });
+}
+
+// P2G's runs (kirchhoff_times_volume_of: any particles in any order, a few at a
+// time, core/solver_impl.hpp) give each particle the stress pass's bits: a
+// particle's stress does not depend on the batch that computes it. States away
+// from the initial one (a return map after a larger deformation).
+TEST_P(ModelConformance, RunsGiveEachParticleThePassBits) {
+  ForDim([&]<int Dim>(const ConstitutiveModel<Dim>& m) {
+    std::vector<Mat<Dim>> Fs;
+    for (int s = 0; s < 150; ++s) Fs.push_back(RandomF<Dim>(gen_, 0.3));
+    Particles<Dim> P = MakeParticles(m, Fs);
+    m.return_map(P, Ids(P.size()), 1e-3);
+    std::vector<Mat<Dim>> tauV(P.size());
+    m.kirchhoff_times_volume(P, Ids(P.size()), tauV);
+    std::vector<int> order = Ids(P.size());
+    std::shuffle(order.begin(), order.end(), gen_);
+    // Runs of 1, of fewer and more than a batch of logarithms (64), and the rest.
+    std::size_t first = 0;
+    for (const std::size_t length :
+         {std::size_t{1}, std::size_t{37}, std::size_t{100}, order.size()}) {
+      const std::size_t count = std::min(length, order.size() - first);
+      std::vector<Mat<Dim>> out(count, Mat<Dim>::Constant(std::nan("")));
+      m.kirchhoff_times_volume_of(P, std::span<const int>(&order[first], count), out.data());
+      for (std::size_t k = 0; k < count; ++k) {
+        const int p = order[first + k];
+        EXPECT_TRUE(out[k] == tauV[p]) << "particle " << p << " in a run of " << count << ":\n"
+                                       << out[k] << "\npass:\n"
+                                       << tauV[p];
+      }
+      first += count;
+    }
+    EXPECT_EQ(first, order.size());
   });
 }
 
