@@ -6,6 +6,7 @@
 
 #include <algorithm>
 #include <array>
+#include <cstring>
 #include <memory>
 #include <span>
 #include <string>
@@ -18,6 +19,7 @@
 #include "core/particles.hpp"
 #include "core/thread_split.hpp"
 #include "core/types.hpp"
+#include "models/lanes.hpp"
 
 namespace mpmtb {
 
@@ -243,11 +245,40 @@ class ModelBase : public ConstitutiveModel<Dim> {
     }
   }
   // out(k) = V0_p tau_p for the particles p = ids[k] of one batch (count <=
-  // kLogBatch), with the batch's logarithms where the formula takes them.
+  // kLogBatch), with the batch's logarithms where the formula takes them; a
+  // vector register of particles at a time where Derived writes its formula
+  // over lanes (tau_times_volume_lanes, models/lanes.hpp). (Neo-Hookean in the
+  // 3D block, 1 thread, perf: the stresses 9.7 % of the step particle by
+  // particle, 7.1 % in lanes, plus the logarithms.)
   template <class Out>
   MPMTB_INLINE void stress_batch(const Particles<Dim>& particles, const int* ids, int count,
                                  Out&& out) const {
-    if constexpr (stress_takes_log()) {
+    if constexpr (stress_in_lanes()) {
+      constexpr int kGroups = kLogBatch / kLanes;
+      static_assert(kGroups * kLanes == kLogBatch, "whole registers");
+      Lanes F[kGroups][Dim][Dim];
+      alignas(sizeof(Lanes)) Real J[kLogBatch] = {}, logJ[kLogBatch];  // zeroed as in with_log
+      const int groups = (count + kLanes - 1) / kLanes;
+      const auto lanes_of = [&](int g) { return std::min(kLanes, count - g * kLanes); };
+      for (int g = 0; g < groups; ++g) {
+        load_lanes<Dim>(particles.F, ids + g * kLanes, lanes_of(g), F[g]);
+        const Lanes det = determinant_of<Dim>(F[g]);
+        std::memcpy(&J[g * kLanes], &det, sizeof det);  // the identity's 1 beyond count
+      }
+      batch_log(J, logJ, groups * kLanes);
+      for (int g = 0; g < groups; ++g) {
+        const int* const group = ids + g * kLanes;
+        Lanes log_J, tauV[Dim][Dim];
+        std::memcpy(&log_J, &logJ[g * kLanes], sizeof log_J);
+        const Lanes V0 = lanes_from(lanes_of(g), Real(0), [&](int l) MPMTB_INLINE_LAMBDA {
+          return particles.V0[group[l]];
+        });
+        self().tau_times_volume_lanes(F[g], log_J, V0, tauV);
+        store_lanes<Dim>(tauV, lanes_of(g), [&](int l) MPMTB_INLINE_LAMBDA -> Mat<Dim>& {
+          return out(g * kLanes + l);
+        });
+      }
+    } else if constexpr (stress_takes_log()) {
       with_log<stress_takes_power()>(particles, ids, count,
                                      [&](int k, int p, Real logJ, Real power) MPMTB_INLINE_LAMBDA {
                                        tau_times_volume(particles, p, logJ, power, out(k));
@@ -255,6 +286,11 @@ class ModelBase : public ConstitutiveModel<Dim> {
     } else {
       for (int k = 0; k < count; ++k) tau_times_volume(particles, ids[k], Real(0), Real(1), out(k));
     }
+  }
+  static constexpr bool stress_in_lanes() {
+    return requires(const Derived& d, const Lanes(&F)[Dim][Dim], Lanes v, Lanes(&out)[Dim][Dim]) {
+      d.tau_times_volume_lanes(F, v, v, out);
+    };
   }
   // Which stress formula Derived has, the first of: V0 tau from ln J and
   // exp(kPowerOfLog ln J); V0 tau from ln J; tau from ln J; tau from F alone.

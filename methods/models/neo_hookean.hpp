@@ -46,11 +46,38 @@ class NeoHookean final : public ModelBase<Dim, NeoHookean<Dim>> {
   Mat<Dim> tau(const Mat<Dim>& F, const Real* q) const {
     return tau_given_log(F, std::log(F.determinant()), q);
   }
-  // tau with ln J given: the stress pass takes the logarithms of a batch at once
-  // (ModelBase::kirchhoff_times_volume).
+  // tau with ln J given, through the batches' formula below (one particle).
   Mat<Dim> tau_given_log(const Mat<Dim>& F, Real logJ, const Real*) const {
-    return c_.mu * (F * F.transpose() - Mat<Dim>::Identity()) +
-           c_.lambda * logJ * Mat<Dim>::Identity();
+    Real f[Dim][Dim], tau[Dim][Dim];
+    for (int i = 0; i < Dim; ++i) {
+      for (int j = 0; j < Dim; ++j) f[i][j] = F(i, j);
+    }
+    tau_times_volume_lanes<Real>(f, logJ, 1, tau);
+    Mat<Dim> out;
+    for (int i = 0; i < Dim; ++i) {
+      for (int j = 0; j < Dim; ++j) out(i, j) = tau[i][j];
+    }
+    return out;
+  }
+  // V0 tau = V0 (mu (F F^T - I) + lambda ln J I) with ln J given, lane by lane
+  // (models/lanes.hpp: the stress pass takes a register of particles at a time
+  // and the logarithms of a batch at once, ModelBase::stress_batch). F F^T is
+  // symmetric: its upper triangle, each entry summed over k in order. (Eigen's
+  // F * F.transpose() summed rows 0 and 1 in vector registers with FMA and row
+  // 2 without on AVX-512 targets, another way on SSE2 ones: neither symmetric
+  // bit for bit nor the same bits across instruction sets. This order is.)
+  template <class T>
+  MPMTB_INLINE void tau_times_volume_lanes(const T (&F)[Dim][Dim], T logJ, T V0,
+                                           T (&out)[Dim][Dim]) const {
+    const T lambda_logJ = c_.lambda * logJ;
+    for (int i = 0; i < Dim; ++i) {
+      for (int j = i; j < Dim; ++j) {
+        T FFt = F[i][0] * F[j][0];
+        for (int k = 1; k < Dim; ++k) FFt = FFt + F[i][k] * F[j][k];
+        out[i][j] = V0 * (i == j ? c_.mu * (FFt - Real(1)) + lambda_logJ : c_.mu * FFt);
+        out[j][i] = out[i][j];
+      }
+    }
   }
   // The differential of P with d(F^-T) = -F^-T dF^T F^-T and d ln J = F^-T : dF
   // (Bonet & Wood 2008, sec. 6.4.3):

@@ -15,6 +15,7 @@
 
 #include "core/particles.hpp"
 #include "core/state.hpp"
+#include "models/lanes.hpp"
 #include "models/model.hpp"
 #include "models/registry.hpp"
 #include "support/random_matrices.hpp"
@@ -143,6 +144,31 @@ TEST(ModelBase, RunAcrossMaterialsGivesEachParticleItsMaterialsStress) {
     s.materials[0]->kirchhoff_times_volume_of(s.particles, std::span<const int>(&p, 1), &other);
     EXPECT_FALSE(other == pass[p]) << "particle " << p;
   }
+}
+
+// The stress batches' determinant over a register of particles
+// (models/lanes.hpp) is each particle's F.determinant(), bit for bit: their
+// logarithms are those of the per-particle formulas.
+template <int Dim>
+void expect_lane_determinants_are_eigens() {
+  std::mt19937 gen(Dim);
+  std::vector<Mat<Dim>> F(kLanes + 3);
+  std::vector<int> ids(F.size());
+  for (std::size_t p = 0; p < F.size(); ++p) {
+    F[p] = testing::RandomF<Dim>(gen, Real(0.5));
+    ids[p] = static_cast<int>(F.size() - 1 - p);
+  }
+  Lanes packs[Dim][Dim];
+  load_lanes<Dim>(F, ids.data(), kLanes - 1, packs);  // the last lane: the identity
+  const Lanes det = determinant_of<Dim>(packs);
+  for (int l = 0; l < kLanes - 1; ++l) EXPECT_EQ(det[l], F[ids[l]].determinant()) << "lane " << l;
+  EXPECT_EQ(det[kLanes - 1], Real(1));
+}
+
+TEST(ModelBase, LaneDeterminantsAreEigens) {
+  expect_lane_determinants_are_eigens<1>();
+  expect_lane_determinants_are_eigens<2>();
+  expect_lane_determinants_are_eigens<3>();
 }
 
 }  // namespace model_base_test
