@@ -192,6 +192,17 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     tau_entries(F, logJ, s, degradation(damage(q)),
                 [&](int i, int j, Real t) { out(i, j) = V0 * t; });
   }
+  // The same over a register of particles (ModelBase::stress_batch).
+  MPMTB_INLINE void tau_times_volume_lanes(const Particles<Dim>& particles, const int* ids,
+                                           int lanes, const Lanes (&F)[Dim][Dim], Lanes J,
+                                           Lanes logJ, Lanes s, Lanes V0,
+                                           Lanes (&out)[Dim][Dim]) const requires(Dim == 3) {
+    const Lanes g = lanes_from(lanes, Real(1), [&](int l) MPMTB_INLINE_LAMBDA {
+      return degradation(damage(particles.state_of(ids[l])));
+    });
+    tau_entries_of<Lanes>([&](int i, int j) MPMTB_INLINE_LAMBDA { return F[i][j]; }, J, logJ, s, g,
+                          [&](int i, int j, Lanes t) MPMTB_INLINE_LAMBDA { out[i][j] = V0 * t; });
+  }
   // Undamaged Cauchy stress sigma = tau(F, d = 0) / J: the damage driver.
   Mat<Dim> undamaged_cauchy(const Mat<Dim>& F) const {
     return undamaged_cauchy(F, std::log(F.determinant()));
@@ -481,15 +492,21 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   // The same with s = J^(2/dim) given.
   template <class Out>
   MPMTB_INLINE void tau_entries(const Mat<Dim>& F, Real logJ, Real s, Real g, Out&& out) const {
-    const Real J = F.determinant();
-    const Real vol = c_.mu * (s - 1) + c_.lambda * logJ;
-    const bool tensile = J >= 1;
+    tau_entries_of<Real>([&](int i, int j) MPMTB_INLINE_LAMBDA { return F(i, j); }, F.determinant(),
+                         logJ, s, g, out);
+  }
+  // The same for T = Real (one particle) or Lanes (a register of particles,
+  // models/lanes.hpp: the tension test a select per lane, the same bits),
+  // F(i, j) the entries, J = det F.
+  template <class T, class FAt, class Out>
+  MPMTB_INLINE void tau_entries_of(FAt&& F, T J, T logJ, T s, T g, Out&& out) const {
+    const T vol = c_.mu * (s - Real(1)) + c_.lambda * logJ;
     for (int j = 0; j < Dim; ++j) {
       for (int i = 0; i <= j; ++i) {
-        Real FFt = F(i, 0) * F(j, 0);
+        T FFt = F(i, 0) * F(j, 0);
         for (int k = 1; k < Dim; ++k) FFt += F(i, k) * F(j, k);
-        const Real dev = c_.mu * (i == j ? FFt - s : FFt);
-        const Real t = i != j ? g * dev : tensile ? g * (dev + vol) : g * dev + vol;
+        const T dev = c_.mu * (i == j ? FFt - s : FFt);
+        const T t = i != j ? T(g * dev) : T(J >= Real(1) ? g * (dev + vol) : g * dev + vol);
         out(i, j, t);
         if (i != j) out(j, i, t);
       }

@@ -266,14 +266,28 @@ class ModelBase : public ConstitutiveModel<Dim> {
         std::memcpy(&J[g * kLanes], &det, sizeof det);  // the identity's 1 beyond count
       }
       batch_log(J, logJ, groups * kLanes);
+      alignas(sizeof(Lanes)) Real power[kLogBatch] = {};
+      if constexpr (stress_takes_power()) {
+        alignas(sizeof(Lanes)) Real exponent[kLogBatch] = {};  // zeroed as in with_log
+        for (int k = 0; k < groups * kLanes; ++k) exponent[k] = Derived::kPowerOfLog * logJ[k];
+        batch_exp(exponent, power, groups * kLanes);
+      }
+      const auto pack = [](const Real* at) MPMTB_INLINE_LAMBDA {
+        Lanes v;
+        std::memcpy(&v, at, sizeof v);
+        return v;
+      };
       for (int g = 0; g < groups; ++g) {
         const int* const group = ids + g * kLanes;
-        Lanes log_J, tauV[Dim][Dim];
-        std::memcpy(&log_J, &logJ[g * kLanes], sizeof log_J);
+        Lanes tauV[Dim][Dim];
         const Lanes V0 = lanes_from(lanes_of(g), Real(0), [&](int l) MPMTB_INLINE_LAMBDA {
           return particles.V0[group[l]];
         });
-        self().tau_times_volume_lanes(F[g], log_J, V0, tauV);
+        const Lanes J_g = pack(&J[g * kLanes]), logJ_g = pack(&logJ[g * kLanes]);
+        Lanes power_g = Lanes{} + Real(1);
+        if constexpr (stress_takes_power()) power_g = pack(&power[g * kLanes]);
+        self().tau_times_volume_lanes(particles, group, lanes_of(g), F[g], J_g, logJ_g, power_g, V0,
+                                      tauV);
         store_lanes<Dim>(tauV, lanes_of(g), [&](int l) MPMTB_INLINE_LAMBDA -> Mat<Dim>& {
           return out(g * kLanes + l);
         });
@@ -287,9 +301,14 @@ class ModelBase : public ConstitutiveModel<Dim> {
       for (int k = 0; k < count; ++k) tau_times_volume(particles, ids[k], Real(0), Real(1), out(k));
     }
   }
+  // Derived's formula over lanes: tau_times_volume_lanes(particles, ids, lanes,
+  // F, J, ln J, power, V0, out) for the particles ids[0] .. ids[lanes - 1] (the
+  // others' lanes hold the identity), power = exp(kPowerOfLog ln J) where the
+  // model has that formula (stress_takes_power), else 1.
   static constexpr bool stress_in_lanes() {
-    return requires(const Derived& d, const Lanes(&F)[Dim][Dim], Lanes v, Lanes(&out)[Dim][Dim]) {
-      d.tau_times_volume_lanes(F, v, v, out);
+    return requires(const Derived& d, const Particles<Dim>& P, const int* ids,
+                    const Lanes(&F)[Dim][Dim], Lanes v, Lanes(&out)[Dim][Dim]) {
+      d.tau_times_volume_lanes(P, ids, 1, F, v, v, v, v, out);
     };
   }
   // Which stress formula Derived has, the first of: V0 tau from ln J and

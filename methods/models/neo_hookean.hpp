@@ -66,6 +66,12 @@ class NeoHookean final : public ModelBase<Dim, NeoHookean<Dim>> {
   // F * F.transpose() summed rows 0 and 1 in vector registers with FMA and row
   // 2 without on AVX-512 targets, another way on SSE2 ones: neither symmetric
   // bit for bit nor the same bits across instruction sets. This order is.)
+  // ModelBase::stress_batch's call: no state, no power of J.
+  MPMTB_INLINE void tau_times_volume_lanes(const Particles<Dim>&, const int*, int,
+                                           const Lanes (&F)[Dim][Dim], Lanes, Lanes logJ, Lanes,
+                                           Lanes V0, Lanes (&out)[Dim][Dim]) const {
+    tau_times_volume_lanes<Lanes>(F, logJ, V0, out);
+  }
   template <class T>
   MPMTB_INLINE void tau_times_volume_lanes(const T (&F)[Dim][Dim], T logJ, T V0,
                                            T (&out)[Dim][Dim]) const {
