@@ -1,6 +1,7 @@
 // The constitutive-model interface. A model is chosen per material at run time
-// and called once per material per stage (a batch over its particles), never
-// inside the particle-node loops. Concrete models derive from ModelBase, which
+// and called once per material per stage (a batch over its particles), or once
+// per run of P2G's scatter (kirchhoff_times_volume_of), never inside the
+// particle-node loops. Concrete models derive from ModelBase, which
 // writes the batch loops once over the model's per-particle formulas.
 #pragma once
 
