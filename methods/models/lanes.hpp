@@ -50,7 +50,7 @@ MPMTB_INLINE inline Lanes lanes_from(int lanes, Real rest, F&& f) {
 // out[i][j] = M[ids[l]](i, j) in lane l < lanes; the identity in the others.
 template <int Dim>
 MPMTB_INLINE inline void load_lanes(const std::vector<Mat<Dim>>& M, const int* ids, int lanes,
-                             Lanes (&out)[Dim][Dim]) {
+                                    Lanes (&out)[Dim][Dim]) {
   for (int i = 0; i < Dim; ++i) {
     for (int j = 0; j < Dim; ++j) {
       out[i][j] = lanes_from(lanes, i == j ? Real(1) : Real(0),
