@@ -347,8 +347,7 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   // strikes, when it settles every particle.)
   int unsettled(const Particles<Dim>& P, const int* ids, int count, Real dt, Real* J,
                 int* kept) const {
-    using Lanes = typename PackOf<kSimdBytes>::type;
-    constexpr int L = kSimdBytes / sizeof(Real);
+    constexpr int L = kLanes;  // models/lanes.hpp
     int m = 0;
     for (int first = 0; first < count; first += L) {
       const int n = std::min(L, count - first);
@@ -360,28 +359,13 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
           for (int j = 0; j < Dim; ++j) F[i][j][k] = P.F[p](i, j);
         d[k] = q[kDamage], lap[k] = q[kLapDamage], diag[k] = q[kLapDiagonal];
       }
-      const Lanes det = determinant_lanes(F);
+      const Lanes det = determinant_of<Dim>(F);  // Eigen's, lane by lane
       const auto settled = settled_lanes(F, det, d, lap, diag, dt);
       for (int k = 0; k < n; ++k) {
         if (!settled[k]) J[m] = det[k], kept[m++] = ids[first + k];
       }
     }
     return m;
-  }
-  // det F as Eigen forms it (LU/Determinant.h: the cofactors of the first row,
-  // in its order of operations), lane by lane.
-  template <class Lanes>
-  MPMTB_INLINE static Lanes determinant_lanes(const Lanes (&F)[Dim][Dim]) {
-    if constexpr (Dim == 1) {
-      return F[0][0];
-    } else if constexpr (Dim == 2) {
-      return F[0][0] * F[1][1] - F[1][0] * F[0][1];
-    } else {
-      const auto cofactor = [&](int a, int b, int c) MPMTB_INLINE_LAMBDA {
-        return F[0][a] * (F[1][b] * F[2][c] - F[1][c] * F[2][b]);
-      };
-      return cofactor(0, 1, 2) - cofactor(1, 0, 2) + cofactor(2, 0, 1);
-    }
   }
   // settled(F, J, q, dt) lane by lane, with q's damage, lap d and its diagonal
   // in d_old, lap and diag: the mask of the particles settled.

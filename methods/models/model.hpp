@@ -237,13 +237,19 @@ class ModelBase : public ConstitutiveModel<Dim> {
     }
     batch_log(J, logJ, count);
     if constexpr (kPower) {
-      Real exponent[kLogBatch] = {}, power[kLogBatch];  // zeroed as J
-      for (int k = 0; k < count; ++k) exponent[k] = Derived::kPowerOfLog * logJ[k];
-      batch_exp(exponent, power, count);
+      Real power[kLogBatch];
+      powers_of_log(logJ, power, count);
       for (int k = 0; k < count; ++k) f(k, skips ? kept[k] : ids[k], logJ[k], power[k]);
     } else {
       for (int k = 0; k < count; ++k) f(k, skips ? kept[k] : ids[k], logJ[k], Real(1));
     }
+  }
+  // power[k] = exp(Derived::kPowerOfLog logJ[k]) for k < n <= kLogBatch
+  // (core/batch_exp.hpp: lane by lane, so a value does not depend on its batch).
+  MPMTB_INLINE static void powers_of_log(const Real* logJ, Real* power, int n) {
+    Real exponent[kLogBatch] = {};  // zeroed as J in with_log
+    for (int k = 0; k < n; ++k) exponent[k] = Derived::kPowerOfLog * logJ[k];
+    batch_exp(exponent, power, n);
   }
   // out(k) = V0_p tau_p for the particles p = ids[k] of one batch (count <=
   // kLogBatch), with the batch's logarithms where the formula takes them; a
@@ -268,11 +274,7 @@ class ModelBase : public ConstitutiveModel<Dim> {
       }
       batch_log(J, logJ, groups * kLanes);
       alignas(sizeof(Lanes)) Real power[kLogBatch] = {};
-      if constexpr (stress_takes_power()) {
-        alignas(sizeof(Lanes)) Real exponent[kLogBatch] = {};  // zeroed as in with_log
-        for (int k = 0; k < groups * kLanes; ++k) exponent[k] = Derived::kPowerOfLog * logJ[k];
-        batch_exp(exponent, power, groups * kLanes);
-      }
+      if constexpr (stress_takes_power()) powers_of_log(logJ, power, groups * kLanes);
       const auto pack = [](const Real* at) MPMTB_INLINE_LAMBDA {
         Lanes v;
         std::memcpy(&v, at, sizeof v);
