@@ -45,6 +45,10 @@ struct State {
   // model, serially (a run of P2G's scatter: core/solver_impl.hpp).
   void kirchhoff_times_volume_of(std::span<const int> ids, Mat<Dim>* out) const {
     if (ids.empty()) return;
+    if (materials.size() == 1) {  // (the scan below read each particle's material)
+      materials[0]->kirchhoff_times_volume_of(particles, ids, out);
+      return;
+    }
     const std::vector<int>& material = particles.material;
     const int first = material[ids[0]];
     if (std::all_of(ids.begin(), ids.end(), [&](int p) { return material[p] == first; })) {

@@ -347,7 +347,7 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   // strikes, when it settles every particle.)
   int unsettled(const Particles<Dim>& P, const int* ids, int count, Real dt, Real* J,
                 int* kept) const {
-    constexpr int L = kLanes;  // models/lanes.hpp
+    constexpr int L = kLanes;  // core/lanes.hpp
     int m = 0;
     for (int first = 0; first < count; first += L) {
       const int n = std::min(L, count - first);
@@ -480,7 +480,7 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
                          logJ, s, g, out);
   }
   // The same for T = Real (one particle) or Lanes (a register of particles,
-  // models/lanes.hpp: the tension test a select per lane, the same bits),
+  // core/lanes.hpp: the tension test a select per lane, the same bits),
   // F(i, j) the entries, J = det F.
   template <class T, class FAt, class Out>
   MPMTB_INLINE void tau_entries_of(FAt&& F, T J, T logJ, T s, T g, Out&& out) const {

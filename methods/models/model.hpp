@@ -20,7 +20,7 @@
 #include "core/particles.hpp"
 #include "core/thread_split.hpp"
 #include "core/types.hpp"
-#include "models/lanes.hpp"
+#include "core/lanes.hpp"
 
 namespace mpmtb {
 
@@ -254,7 +254,7 @@ class ModelBase : public ConstitutiveModel<Dim> {
   // out(k) = V0_p tau_p for the particles p = ids[k] of one batch (count <=
   // kLogBatch), with the batch's logarithms where the formula takes them; a
   // vector register of particles at a time where Derived writes its formula
-  // over lanes (tau_times_volume_lanes, models/lanes.hpp). (Neo-Hookean in the
+  // over lanes (tau_times_volume_lanes, core/lanes.hpp). (Neo-Hookean in the
   // 3D block, 1 thread, perf: the stresses 9.7 % of the step particle by
   // particle, 7.1 % in lanes, plus the logarithms.)
   template <class Out>

@@ -60,7 +60,7 @@ class NeoHookean final : public ModelBase<Dim, NeoHookean<Dim>> {
     return out;
   }
   // V0 tau = V0 (mu (F F^T - I) + lambda ln J I) with ln J given, lane by lane
-  // (models/lanes.hpp: the stress pass takes a register of particles at a time
+  // (core/lanes.hpp: the stress pass takes a register of particles at a time
   // and the logarithms of a batch at once, ModelBase::stress_batch). F F^T is
   // symmetric: its upper triangle, each entry summed over k in order. (Eigen's
   // F * F.transpose() summed rows 0 and 1 in vector registers with FMA and row

@@ -93,7 +93,7 @@ TEST(BatchLog, EveryLengthGivesTheSameValuesAsOneByOne) {
 // particles than two batches of 64, in reverse order:
 // - is V0 P F^T of the model's own first Piola stress;
 // - takes these models a vector register of particles at a time
-//   (models/lanes.hpp), and gives each particle the bits of the model's formula
+//   (core/lanes.hpp), and gives each particle the bits of the model's formula
 //   for one particle, given the same ln J (and J^(2/3) for damage).
 // Compressed and stretched particles (J from 0.5 to 1.7: damage's tension
 // split) and damaged ones (d from 0 to 0.9).

@@ -13,9 +13,9 @@
 #include <string>
 #include <vector>
 
+#include "core/lanes.hpp"
 #include "core/particles.hpp"
 #include "core/state.hpp"
-#include "models/lanes.hpp"
 #include "models/model.hpp"
 #include "models/registry.hpp"
 #include "support/random_matrices.hpp"
@@ -147,7 +147,7 @@ TEST(ModelBase, RunAcrossMaterialsGivesEachParticleItsMaterialsStress) {
 }
 
 // The stress batches' determinant over a register of particles
-// (models/lanes.hpp) is each particle's F.determinant(), bit for bit: their
+// (core/lanes.hpp) is each particle's F.determinant(), bit for bit: their
 // logarithms are those of the per-particle formulas.
 template <int Dim>
 void expect_lane_determinants_are_eigens() {
@@ -169,6 +169,51 @@ TEST(ModelBase, LaneDeterminantsAreEigens) {
   expect_lane_determinants_are_eigens<1>();
   expect_lane_determinants_are_eigens<2>();
   expect_lane_determinants_are_eigens<3>();
+}
+
+// Matrices and vectors into registers and back (core/lanes.hpp), whole
+// registers (3D: rows of 8 Reals and transposes) and partly filled ones (lane
+// by lane): lane l holds particle ids[l]'s values, and the store returns them.
+template <int Dim>
+void expect_lanes_hold_each_particle() {
+  std::mt19937 gen(10 + Dim);
+  std::uniform_real_distribution<Real> value(-1, 1);
+  std::vector<Mat<Dim>> F(3 * kLanes);
+  std::vector<Vec<Dim>> v(F.size());
+  std::vector<int> ids(F.size());
+  for (std::size_t p = 0; p < F.size(); ++p) {
+    F[p] = testing::RandomF<Dim>(gen, Real(0.5));
+    for (int a = 0; a < Dim; ++a) v[p][a] = value(gen);
+    ids[p] = static_cast<int>((7 * p + 3) % F.size());  // out of order
+  }
+  for (const int lanes : {kLanes, kLanes - 1}) {
+    Lanes packs[Dim][Dim];
+    load_lanes<Dim>(F, ids.data(), lanes, packs);
+    for (int l = 0; l < kLanes; ++l) {
+      for (int i = 0; i < Dim; ++i) {
+        for (int j = 0; j < Dim; ++j) {
+          const Real expected = l < lanes ? F[ids[l]](i, j) : Real(i == j);
+          EXPECT_EQ(packs[i][j][l], expected) << lanes << " lanes, lane " << l;
+        }
+      }
+    }
+    std::vector<Mat<Dim>> back(kLanes, Mat<Dim>::Constant(-7));
+    store_lanes<Dim>(packs, lanes, [&](int l) -> Mat<Dim>& { return back[l]; });
+    for (int l = 0; l < kLanes; ++l) {
+      EXPECT_EQ(back[l], l < lanes ? F[ids[l]] : Mat<Dim>::Constant(-7)) << "lane " << l;
+    }
+  }
+  Lanes components[Dim];
+  load_vector_lanes<Dim>(&v[5], components);
+  for (int l = 0; l < kLanes; ++l) {
+    for (int a = 0; a < Dim; ++a) EXPECT_EQ(components[a][l], v[5 + l][a]) << "lane " << l;
+  }
+}
+
+TEST(ModelBase, LanesHoldEachParticlesValues) {
+  expect_lanes_hold_each_particle<1>();
+  expect_lanes_hold_each_particle<2>();
+  expect_lanes_hold_each_particle<3>();
 }
 
 }  // namespace model_base_test

@@ -1,0 +1,163 @@
+// A per-particle formula over a vector register of particles, one particle per
+// lane (ModelBase's stress batches, G2P's failure check): F_p's entries in, one
+// pack per entry, and V0_p tau_p out. A formula written once as a template on its number
+// type T runs with T = Lanes in the batches and with T = Real for one particle,
+// the same operations in each lane, so the two give the same bits.
+#pragma once
+
+#include <cstring>
+#include <utility>
+#include <vector>
+
+#include "core/batch_log.hpp"
+#include "core/types.hpp"
+
+#pragma GCC diagnostic push
+#pragma GCC diagnostic ignored "-Wpsabi"
+
+namespace mpmtb {
+
+using Lanes = detail::LogPack;  // the batch logarithm's register (core/batch_log.hpp)
+inline constexpr int kLanes = detail::kLogLanes;
+
+// det F lane by lane: the cofactor expansion along the first row in Eigen's
+// order (Eigen/src/LU/Determinant.h), so that each lane is F_p.determinant().
+template <int Dim, class T>
+MPMTB_INLINE inline T determinant_of(const T (&F)[Dim][Dim]) {
+  if constexpr (Dim == 1) {
+    return F[0][0];
+  } else if constexpr (Dim == 2) {
+    return F[0][0] * F[1][1] - F[1][0] * F[0][1];
+  } else {
+    const auto term = [&](int a, int b, int c) MPMTB_INLINE_LAMBDA {
+      return F[0][a] * (F[1][b] * F[2][c] - F[1][c] * F[2][b]);
+    };
+    return term(0, 1, 2) - term(1, 0, 2) + term(2, 0, 1);
+  }
+}
+
+// Lane l of each pack from f(l) for l < lanes, `rest` beyond. Built in
+// registers: lanes stored one by one and loaded as a pack would stall the
+// load on store forwarding.
+template <class F>
+MPMTB_INLINE inline Lanes lanes_from(int lanes, Real rest, F&& f) {
+  return [&]<int... l>(std::integer_sequence<int, l...>) MPMTB_INLINE_LAMBDA {
+    return Lanes{(l < lanes ? f(l) : rest)...};
+  }
+  (std::make_integer_sequence<int, kLanes>{});
+}
+
+// out[e] lane l = in[l] lane e: an 8 x 8 block of Reals transposed in three
+// rounds of two-register shuffles (24 in all), for packs of 8 lanes.
+template <class Pack>
+MPMTB_INLINE inline void transpose8(const Pack (&in)[8], Pack (&out)[8]) {
+  Pack t[8], u[8];
+  for (int i = 0; i < 8; i += 2) {  // lanes (even, odd entries) of rows i, i + 1
+    t[i] = __builtin_shufflevector(in[i], in[i + 1], 0, 8, 2, 10, 4, 12, 6, 14);
+    t[i + 1] = __builtin_shufflevector(in[i], in[i + 1], 1, 9, 3, 11, 5, 13, 7, 15);
+  }
+  for (int i = 0; i < 8; i += 4) {  // entries (e, e + 4) of rows i .. i + 3
+    for (int odd = 0; odd < 2; ++odd) {
+      const Pack& a = t[i + odd];
+      const Pack& b = t[i + 2 + odd];
+      u[i + odd] = __builtin_shufflevector(a, b, 0, 1, 8, 9, 4, 5, 12, 13);
+      u[i + 2 + odd] = __builtin_shufflevector(a, b, 2, 3, 10, 11, 6, 7, 14, 15);
+    }
+  }
+  for (int e = 0; e < 4; ++e) {  // rows 0 .. 3 and 4 .. 7 of entries e and e + 4
+    out[e] = __builtin_shufflevector(u[e], u[4 + e], 0, 1, 2, 3, 8, 9, 10, 11);
+    out[e + 4] = __builtin_shufflevector(u[e], u[4 + e], 4, 5, 6, 7, 12, 13, 14, 15);
+  }
+}
+
+// Whole registers of 3x3 matrices move by rows of 8 Reals and transpose8
+// (perf: lane by lane, the stress batches' loads and stores were most of their
+// instructions). F(i, j) is entry i + 3 j of the column-major storage; the
+// ninth, (2, 2), goes lane by lane.
+template <int Dim>
+inline constexpr bool kTransposes = Dim == 3 && kLanes == 8;
+
+// out[i][j] = M[ids[l]](i, j) in lane l < lanes; the identity in the others.
+template <int Dim>
+MPMTB_INLINE inline void load_lanes(const std::vector<Mat<Dim>>& M, const int* ids, int lanes,
+                                    Lanes (&out)[Dim][Dim]) {
+  if constexpr (kTransposes<Dim>) {
+    if (lanes == kLanes) {
+      Lanes rows[8], entries[8];
+      for (int l = 0; l < 8; ++l) std::memcpy(&rows[l], M[ids[l]].data(), sizeof(Lanes));
+      transpose8(rows, entries);
+      for (int e = 0; e < 8; ++e) out[e % 3][e / 3] = entries[e];
+      out[2][2] =
+          lanes_from(kLanes, Real(0), [&](int l) MPMTB_INLINE_LAMBDA { return M[ids[l]](2, 2); });
+      return;
+    }
+  }
+  for (int i = 0; i < Dim; ++i) {
+    for (int j = 0; j < Dim; ++j) {
+      out[i][j] = lanes_from(lanes, i == j ? Real(1) : Real(0),
+                             [&](int l) MPMTB_INLINE_LAMBDA { return M[ids[l]](i, j); });
+    }
+  }
+}
+
+// Lane l = Real 3 l + k of the 24 Reals in a, b, c (8 lanes each): from a and
+// b below 16, else from c.
+template <int k, class Pack>
+MPMTB_INLINE inline Pack every_third(const Pack& a, const Pack& b, const Pack& c) {
+  return [&]<int... l>(std::integer_sequence<int, l...>) MPMTB_INLINE_LAMBDA {
+    const Pack ab = __builtin_shufflevector(a, b, (3 * l + k < 16 ? 3 * l + k : 0)...);
+    return __builtin_shufflevector(ab, c, (3 * l + k < 16 ? l : 3 * l + k - 8)...);
+  }
+  (std::make_integer_sequence<int, 8>{});
+}
+
+// out[a] lane l = v[l][a] for the kLanes vectors v[0] .. v[kLanes - 1] side by
+// side in memory: whole-register loads and shuffles where kTransposes<Dim>.
+template <int Dim>
+MPMTB_INLINE inline void load_vector_lanes(const Vec<Dim>* v, Lanes (&out)[Dim]) {
+  static_assert(sizeof(Vec<Dim>) == Dim * sizeof(Real), "vectors side by side");
+  if constexpr (kTransposes<Dim>) {
+    Lanes a, b, c;  // the 24 Reals
+    std::memcpy(&a, v[0].data(), sizeof a);
+    std::memcpy(&b, v[0].data() + 8, sizeof b);
+    std::memcpy(&c, v[0].data() + 16, sizeof c);
+    out[0] = every_third<0>(a, b, c);
+    out[1] = every_third<1>(a, b, c);
+    out[2] = every_third<2>(a, b, c);
+  } else {
+    for (int a = 0; a < Dim; ++a)
+      out[a] = lanes_from(kLanes, Real(0), [&](int l) MPMTB_INLINE_LAMBDA { return v[l][a]; });
+  }
+}
+
+// out(l) = the matrix of lane l, for l < lanes.
+template <int Dim, class Out>
+MPMTB_INLINE inline void store_lanes(const Lanes (&in)[Dim][Dim], int lanes, Out&& out) {
+  if constexpr (kTransposes<Dim>) {
+    if (lanes == kLanes) {
+      Lanes entries[8], rows[8];
+      for (int e = 0; e < 8; ++e) entries[e] = in[e % 3][e / 3];
+      transpose8(entries, rows);
+      alignas(sizeof(Lanes)) Real last[kLanes];
+      std::memcpy(last, &in[2][2], sizeof last);
+      for (int l = 0; l < 8; ++l) {
+        Mat<Dim>& m = out(l);
+        std::memcpy(m.data(), &rows[l], sizeof(Lanes));
+        m(2, 2) = last[l];
+      }
+      return;
+    }
+  }
+  alignas(sizeof(Lanes)) Real e[Dim][Dim][kLanes];
+  std::memcpy(e, in, sizeof e);
+  for (int l = 0; l < lanes; ++l) {
+    Mat<Dim>& m = out(l);
+    for (int i = 0; i < Dim; ++i) {
+      for (int j = 0; j < Dim; ++j) m(i, j) = e[i][j][l];
+    }
+  }
+}
+
+}  // namespace mpmtb
+
+#pragma GCC diagnostic pop
