@@ -70,12 +70,35 @@ MPMTB_INLINE inline void transpose8(const Pack (&in)[8], Pack (&out)[8]) {
   }
 }
 
-// Whole registers of 3x3 matrices move by rows of 8 Reals and transpose8
-// (perf: lane by lane, the stress batches' loads and stores were most of their
-// instructions). F(i, j) is entry i + 3 j of the column-major storage; the
-// ninth, (2, 2), goes lane by lane.
+// Whole registers of 3x3 matrices move by rows of 8 Reals and transpose8, 8
+// lanes at a time (perf: lane by lane, the stress batches' loads and stores
+// were most of their instructions). F(i, j) is entry i + 3 j of the
+// column-major storage; the ninth, (2, 2), goes lane by lane.
 template <int Dim>
-inline constexpr bool kTransposes = Dim == 3 && kLanes == 8;
+inline constexpr bool kTransposes = Dim == 3 && kLanes % 8 == 0 && kLanes <= 16;
+using Eight = typename PackOf<8 * sizeof(Real)>::type;        // 8 lanes
+inline constexpr int kEights = kLanes >= 8 ? kLanes / 8 : 1;  // in a register of Lanes
+
+// Lanes 8 b .. 8 b + 7 of x, and the register of the kEights blocks e[b].
+// (Templates: instantiated only where kTransposes.)
+template <class L = Lanes>
+MPMTB_INLINE inline Eight eight_of(const L& x, int b) {
+  if constexpr (kEights == 1) {
+    return x;
+  } else {
+    return b == 0 ? __builtin_shufflevector(x, x, 0, 1, 2, 3, 4, 5, 6, 7)
+                  : __builtin_shufflevector(x, x, 8, 9, 10, 11, 12, 13, 14, 15);
+  }
+}
+template <class E = Eight>
+MPMTB_INLINE inline Lanes whole_of(const E (&e)[kEights]) {
+  if constexpr (kEights == 1) {
+    return e[0];
+  } else {
+    return __builtin_shufflevector(e[0], e[1], 0, 1, 2, 3, 4, 5, 6, 7, 8, 9, 10, 11, 12, 13, 14,
+                                   15);
+  }
+}
 
 // out[i][j] = M[ids[l]](i, j) in lane l < lanes; the identity in the others.
 template <int Dim>
@@ -83,10 +106,14 @@ MPMTB_INLINE inline void load_lanes(const std::vector<Mat<Dim>>& M, const int* i
                                     Lanes (&out)[Dim][Dim]) {
   if constexpr (kTransposes<Dim>) {
     if (lanes == kLanes) {
-      Lanes rows[8], entries[8];
-      for (int l = 0; l < 8; ++l) std::memcpy(&rows[l], M[ids[l]].data(), sizeof(Lanes));
-      transpose8(rows, entries);
-      for (int e = 0; e < 8; ++e) out[e % 3][e / 3] = entries[e];
+      Eight entries[8][kEights];
+      for (int b = 0; b < kEights; ++b) {
+        Eight rows[8], block[8];
+        for (int l = 0; l < 8; ++l) std::memcpy(&rows[l], M[ids[8 * b + l]].data(), sizeof(Eight));
+        transpose8(rows, block);
+        for (int e = 0; e < 8; ++e) entries[e][b] = block[e];
+      }
+      for (int e = 0; e < 8; ++e) out[e % 3][e / 3] = whole_of(entries[e]);
       out[2][2] =
           lanes_from(kLanes, Real(0), [&](int l) MPMTB_INLINE_LAMBDA { return M[ids[l]](2, 2); });
       return;
@@ -100,15 +127,16 @@ MPMTB_INLINE inline void load_lanes(const std::vector<Mat<Dim>>& M, const int* i
   }
 }
 
-// Lane l = Real 3 l + k of the 24 Reals in a, b, c (8 lanes each): from a and
-// b below 16, else from c.
+// Lane l = Real 3 l + k of the 3 N Reals in a, b, c (N lanes each): from a and
+// b below 2 N, else from c.
 template <int k, class Pack>
 MPMTB_INLINE inline Pack every_third(const Pack& a, const Pack& b, const Pack& c) {
+  constexpr int N = sizeof(Pack) / sizeof(Real);
   return [&]<int... l>(std::integer_sequence<int, l...>) MPMTB_INLINE_LAMBDA {
-    const Pack ab = __builtin_shufflevector(a, b, (3 * l + k < 16 ? 3 * l + k : 0)...);
-    return __builtin_shufflevector(ab, c, (3 * l + k < 16 ? l : 3 * l + k - 8)...);
+    const Pack ab = __builtin_shufflevector(a, b, (3 * l + k < 2 * N ? 3 * l + k : 0)...);
+    return __builtin_shufflevector(ab, c, (3 * l + k < 2 * N ? l : 3 * l + k - N)...);
   }
-  (std::make_integer_sequence<int, 8>{});
+  (std::make_integer_sequence<int, N>{});
 }
 
 // out[a] lane l = v[l][a] for the kLanes vectors v[0] .. v[kLanes - 1] side by
@@ -117,10 +145,10 @@ template <int Dim>
 MPMTB_INLINE inline void load_vector_lanes(const Vec<Dim>* v, Lanes (&out)[Dim]) {
   static_assert(sizeof(Vec<Dim>) == Dim * sizeof(Real), "vectors side by side");
   if constexpr (kTransposes<Dim>) {
-    Lanes a, b, c;  // the 24 Reals
+    Lanes a, b, c;  // the 3 kLanes Reals
     std::memcpy(&a, v[0].data(), sizeof a);
-    std::memcpy(&b, v[0].data() + 8, sizeof b);
-    std::memcpy(&c, v[0].data() + 16, sizeof c);
+    std::memcpy(&b, v[0].data() + kLanes, sizeof b);
+    std::memcpy(&c, v[0].data() + 2 * kLanes, sizeof c);
     out[0] = every_third<0>(a, b, c);
     out[1] = every_third<1>(a, b, c);
     out[2] = every_third<2>(a, b, c);
@@ -135,15 +163,17 @@ template <int Dim, class Out>
 MPMTB_INLINE inline void store_lanes(const Lanes (&in)[Dim][Dim], int lanes, Out&& out) {
   if constexpr (kTransposes<Dim>) {
     if (lanes == kLanes) {
-      Lanes entries[8], rows[8];
-      for (int e = 0; e < 8; ++e) entries[e] = in[e % 3][e / 3];
-      transpose8(entries, rows);
       alignas(sizeof(Lanes)) Real last[kLanes];
       std::memcpy(last, &in[2][2], sizeof last);
-      for (int l = 0; l < 8; ++l) {
-        Mat<Dim>& m = out(l);
-        std::memcpy(m.data(), &rows[l], sizeof(Lanes));
-        m(2, 2) = last[l];
+      for (int b = 0; b < kEights; ++b) {
+        Eight entries[8], rows[8];
+        for (int e = 0; e < 8; ++e) entries[e] = eight_of(in[e % 3][e / 3], b);
+        transpose8(entries, rows);
+        for (int l = 0; l < 8; ++l) {
+          Mat<Dim>& m = out(8 * b + l);
+          std::memcpy(m.data(), &rows[l], sizeof(Eight));
+          m(2, 2) = last[8 * b + l];
+        }
       }
       return;
     }
