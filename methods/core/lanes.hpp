@@ -158,6 +158,22 @@ MPMTB_INLINE inline void load_vector_lanes(const Vec<Dim>* v, Lanes (&out)[Dim])
   }
 }
 
+// Whether every lane of a comparison's mask is true: halves and-ed together
+// (lane by lane, the lanes' extractions were most of G2P's check).
+template <class Mask>
+MPMTB_INLINE inline bool all_lanes(const Mask& m) {
+  constexpr int N = sizeof(Mask) / sizeof(m[0]);
+  if constexpr (N == 1) {
+    return m[0] != 0;
+  } else {
+    return [&]<int... l>(std::integer_sequence<int, l...>) MPMTB_INLINE_LAMBDA {
+      return all_lanes(__builtin_shufflevector(m, m, l...) &
+                       __builtin_shufflevector(m, m, (l + N / 2)...));
+    }
+    (std::make_integer_sequence<int, N / 2>{});
+  }
+}
+
 // out(l) = the matrix of lane l, for l < lanes.
 template <int Dim, class Out>
 MPMTB_INLINE inline void store_lanes(const Lanes (&in)[Dim][Dim], int lanes, Out&& out) {

@@ -86,9 +86,7 @@ class ParticleCheck {
       v2_hi = v2_hi < v2 ? v2 : v2_hi;
       auto fine = (J - J == 0) & (v2 - v2 == 0);  // finite: inf - inf and NaN fail
       for (int a = 0; a < Dim; ++a) fine &= (x[a] >= splat(lo_[a])) & (x[a] <= splat(hi_[a]));
-      bool all_fine = true;
-      for (int l = 0; l < kLanes; ++l) all_fine &= fine[l] != 0;
-      if (!all_fine) {
+      if (!all_lanes(fine)) {
         for (int l = 0; l < kLanes; ++l) classify(P, p + l, J[l], v2[l]);
       }
     }
