@@ -370,8 +370,9 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
 
  private:
   // The scatter that follows writes the policy's kept values of every particle,
-  // or reads them from a pass of their own before it, two particles at a time,
-  // where the policy has one (keep_modes: PolyPIC's modes in 1D and 2D).
+  // or reads them from a pass of their own before it, kKeptTogether particles
+  // at a time, where the policy has one (keep_modes: PolyPIC's modes with 4
+  // nodes per axis).
   void keep_from_scatter(const State<Dim>& s) {
     if constexpr (kKeeps) {
       const Particles<Dim>& P = s.particles;
@@ -379,23 +380,32 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
       kept_.resize(n);
       kept_fresh_ = true;
       const Policy policy(transfer_params_, s.grid.geo.dx);
-      if constexpr (requires(KeptOf<Policy> & k, const StencilT& st) {
-                      policy.keep_modes(st, P.x[0], k, st, P.x[0], k);
+      if constexpr (requires(const StencilT* const(&st)[Policy::kKeptTogether],
+                             const Vec<Dim>* const(&x)[Policy::kKeptTogether],
+                             KeptOf<Policy>* const(&k)[Policy::kKeptTogether]) {
+                      policy.keep_modes(st, x, k);
                     }) {
+        constexpr int G = Policy::kKeptTogether;
         const auto stencil = [&](long p) MPMTB_INLINE_LAMBDA {
           return StencilT(P.x[p], this->domain_F(P, p), s.grid.geo);
         };
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-        for (long a = 0; a < n - 1; a += 2) {
-          policy.keep_modes(stencil(a), P.x[a], kept_[a], stencil(a + 1), P.x[a + 1], kept_[a + 1]);
-        }
-        if (n % 2) {  // the last one paired with itself
-          const StencilT st = stencil(n - 1);
-          policy.keep_modes(st, P.x[n - 1], kept_[n - 1], st, P.x[n - 1], kept_[n - 1]);
+        for (long a = 0; a < n; a += G) {
+          // Particles a .. a + G - 1, the last one repeated past the end.
+          const auto at = [&](int g) MPMTB_INLINE_LAMBDA { return std::min(a + g, n - 1); };
+          [&]<int... g>(std::integer_sequence<int, g...>) MPMTB_INLINE_LAMBDA {
+            const StencilT st[G] = {stencil(at(g))...};
+            const StencilT* const stencils[G] = {&st[g]...};
+            const Vec<Dim>* const x[G] = {&P.x[at(g)]...};
+            KeptOf<Policy>* const kept[G] = {&kept_[at(g)]...};
+            policy.keep_modes(stencils, x, kept);
+          }
+          (std::make_integer_sequence<int, G>{});
         }
       }
     }
   }
+
   // A particle's long records fetched one particle ahead, in P2G and G2P:
   // PolyPIC's higher modes (180 values in 3D with the cubic B-spline) and the
   // modes kept by the pass before P2G. P2G takes the particles in the blocks'

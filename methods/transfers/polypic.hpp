@@ -160,36 +160,57 @@ struct PolyModes {
     root_norm_ = lanes(k.root_norm);
     kept_only_ = true;
   }
-  // The records (keep) of two particles' modes from one build: particle a's axes
-  // in the first Dim lanes, b's in the next (1D, 2D: both in one AxisPack), or
-  // in the second half of a register twice as wide (3D). Every operation of the
-  // build is lane by lane, so each record is the one its particle's own build
-  // gives, bit for bit, in one chain of dependent operations instead of two
+  // The records (keep) of G particles' modes from one build: particle g's axes
+  // in lanes g L .. g L + Dim - 1 of one register (L = Dim, or 4 in 3D: an
+  // AxisPack per particle, two in a register twice as wide). Every operation of
+  // the build is lane by lane, so each record is the one its particle's own
+  // build gives, bit for bit, in one chain of dependent operations instead of G
   // (the build is bound by that chain's latency, not by the operations).
+  static constexpr int kGroupLanes = Dim == 3 ? 4 : Dim;  // L, a particle's lanes
+  // Particles a build takes together: 4 in 2D where their 8 lanes fit one
+  // register (AVX-512 in double, AVX in float), else 2.
+  static constexpr int kGroup = Dim == 2 && 4 * Dim * sizeof(Real) <= kSimdBytes ? 4 : 2;
+  template <int G, class Kernel>
+  static void keep_group(const Stencil<Dim, Kernel>* const (&st)[G], Real dx,
+                         Kept* const (&kept)[G]) {
+    static_assert(std::is_same_v<Lanes, AxisPack>);
+    constexpr int L = kGroupLanes;
+    static_assert(G * L <= 8, "a group fills at most two AxisPacks");
+    using Group = typename PackOf<std::max(4, G * L) * sizeof(Real)>::type;
+    // The lanes of the G particles' factors side by side (x[g]: particle g's),
+    // in shuffles of register pairs. (Written through a reference: a 64-byte
+    // vector returned by value draws GCC's ABI warning on targets without AVX-512.)
+    const auto group = [](const AxisPack(&x)[G], Group& out) MPMTB_INLINE_LAMBDA {
+      if constexpr (L == 1) {
+        static_assert(G == 2);
+        out = __builtin_shufflevector(x[0], x[1], 0, 4, 2, 3);
+      } else if constexpr (L == 2 && G == 2) {
+        out = __builtin_shufflevector(x[0], x[1], 0, 1, 4, 5);
+      } else if constexpr (L == 2) {
+        static_assert(G == 4);
+        const AxisPack x01 = __builtin_shufflevector(x[0], x[1], 0, 1, 4, 5);
+        const AxisPack x23 = __builtin_shufflevector(x[2], x[3], 0, 1, 4, 5);
+        out = __builtin_shufflevector(x01, x23, 0, 1, 2, 3, 4, 5, 6, 7);
+      } else {
+        static_assert(L == 4 && G == 2);
+        out = __builtin_shufflevector(x[0], x[1], 0, 1, 2, 3, 4, 5, 6, 7);
+      }
+    };
+    Group w[S], d[S];
+    for (int k = 0; k < S; ++k) {
+      AxisPack wk[G], dk[G];
+      for (int g = 0; g < G; ++g) wk[g] = st[g]->wk[k], dk[g] = st[g]->dk[k];
+      group(wk, w[k]), group(dk, d[k]);
+    }
+    PolyModes<Dim, S, Group> all;
+    all.build_lanes(w, d, dx);
+    for (int g = 0; g < G; ++g) all.keep(*kept[g], g * L);
+  }
+  // The same for two particles (the unit tests' reference).
   template <class Kernel>
   static void keep_pair(const Stencil<Dim, Kernel>& a, const Stencil<Dim, Kernel>& b, Real dx,
                         Kept& kept_a, Kept& kept_b) {
-    static_assert(std::is_same_v<Lanes, AxisPack>);
-    constexpr bool kOneRegister = 2 * Dim <= 4;
-    using Both =
-        std::conditional_t<kOneRegister, AxisPack, typename PackOf<2 * sizeof(AxisPack)>::type>;
-    // (Written through a reference: a 64-byte vector returned by value draws
-    // GCC's ABI warning on targets without AVX-512.)
-    const auto pair = [](const AxisPack& x, const AxisPack& y, Both& both) MPMTB_INLINE_LAMBDA {
-      if constexpr (Dim == 1) {
-        both = __builtin_shufflevector(x, y, 0, 4, 2, 3);
-      } else if constexpr (Dim == 2) {
-        both = __builtin_shufflevector(x, y, 0, 1, 4, 5);
-      } else {
-        both = __builtin_shufflevector(x, y, 0, 1, 2, 3, 4, 5, 6, 7);
-      }
-    };
-    Both w[S], d[S];
-    for (int k = 0; k < S; ++k) pair(a.wk[k], b.wk[k], w[k]), pair(a.dk[k], b.dk[k], d[k]);
-    PolyModes<Dim, S, Both> both;
-    both.build_lanes(w, d, dx);
-    both.keep(kept_a, 0);
-    both.keep(kept_b, kOneRegister ? Dim : 4);
+    keep_group<2, Kernel>({&a, &b}, dx, {&kept_a, &kept_b});
   }
 
   // The stencil index (last axis fastest, as Stencil::for_each_node) of the node
@@ -462,14 +483,17 @@ class PolypicPolicy {
     g.modes.build(st, dx_);
     return g;
   }
-  // The records of two particles at once (PolyModes::keep_pair), for the pass
-  // over the particles before P2G (core/policy_hooks.hpp): the build is a long
-  // chain of dependent operations, and two particles share one.
-  void keep_modes(const Stencil<Dim, Kernel>& a, const V& xa, Kept& kept_a,
-                  const Stencil<Dim, Kernel>& b, const V& xb, Kept& kept_b) const
+  // The records of kKeptTogether particles at once (PolyModes::keep_group), for
+  // the pass over the particles before P2G (core/policy_hooks.hpp): the build
+  // is a long chain of dependent operations, and they share one.
+  static constexpr int kKeptTogether = Modes::kGroup;
+  void keep_modes(const Stencil<Dim, Kernel>* const (&st)[kKeptTogether],
+                  const V* const (&x)[kKeptTogether], Kept* const (&kept)[kKeptTogether]) const
       requires(kKeepPass) {
-    Modes::keep_pair(a, b, dx_, kept_a.modes, kept_b.modes);
-    kept_a.x = xa, kept_b.x = xb;
+    typename Modes::Kept* modes[kKeptTogether];
+    for (int g = 0; g < kKeptTogether; ++g) modes[g] = &kept[g]->modes;
+    Modes::template keep_group<kKeptTogether, Kernel>(st, dx_, modes);
+    for (int g = 0; g < kKeptTogether; ++g) kept[g]->x = *x[g];
   }
   // The same from P2G's record where it was made at this position (the same
   // stencil, so the same modes, bit for bit): the build, a long chain of

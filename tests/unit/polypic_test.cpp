@@ -9,6 +9,7 @@
 #include <fstream>
 #include <random>
 #include <sstream>
+#include <vector>
 
 #include "core/diagnostics.hpp"
 #include "kernels/all.hpp"
@@ -56,20 +57,20 @@ TEST(PolypicModes, OrthogonalUnderTheWeights) {
   }
 }
 
-// Two particles' modes from one build, their axes side by side in the lanes
-// (PolyModes::keep_pair, the pass before P2G; in 3D in a register twice as wide
-// as one particle's), are each particle's own build, bit for bit: also where a
-// mode is dropped (a particle on a node, or half-way between two with the
-// quadratic B-spline), in one of the two or both.
-template <int Dim, class Kernel>
-void check_pair_build() {
+// G particles' modes from one build, their axes side by side in the lanes
+// (PolyModes::keep_group, the pass before P2G: pairs, in 3D in a register twice
+// as wide as one particle's, and fours in 2D), are each particle's own build,
+// bit for bit: also where a mode is dropped (a particle on a node, or half-way
+// between two with the quadratic B-spline), in some of them or all.
+template <int Dim, class Kernel, int G>
+void check_group_build() {
   constexpr int S = Kernel::support;
   using Modes = PolyModes<Dim, S>;
   const Real dx = 0.1;
   std::array<int, Dim> cells;
   cells.fill(8);
   const GridGeometry<Dim> geo(Vec<Dim>::Zero(), dx, cells);
-  std::mt19937 gen(7 + Dim);
+  std::mt19937 gen(7 + Dim + G);
   std::uniform_real_distribution<Real> inside(0.25, 0.55);
   const auto bits = [](const typename Modes::Kept& k) {
     std::array<unsigned char, sizeof k> b;
@@ -77,33 +78,48 @@ void check_pair_build() {
     return b;
   };
   for (int trial = 0; trial < 40; ++trial) {
-    Vec<Dim> xa, xb;
-    for (int a = 0; a < Dim; ++a) xa[a] = inside(gen), xb[a] = inside(gen);
-    if (trial % 4 == 1) xa = Vec<Dim>::Constant(0.3);   // on a node
-    if (trial % 4 == 2) xb = Vec<Dim>::Constant(0.35);  // half-way
-    if (trial % 4 == 3) xa = xb;
-    const Stencil<Dim, Kernel> sa(xa, geo), sb(xb, geo);
-    typename Modes::Kept pa, pb, alone_a, alone_b;
-    std::memset(&pa, 0xff, sizeof pa), std::memset(&pb, 0xff, sizeof pb);
-    std::memset(&alone_a, 0, sizeof alone_a), std::memset(&alone_b, 0, sizeof alone_b);
-    Modes::keep_pair(sa, sb, dx, pa, pb);
-    Modes ma, mb;
-    ma.build(sa, dx), mb.build(sb, dx);
-    ma.keep(alone_a), mb.keep(alone_b);
-    EXPECT_EQ(bits(pa), bits(alone_a)) << Dim << "D " << Kernel::name << ", trial " << trial;
-    EXPECT_EQ(bits(pb), bits(alone_b)) << Dim << "D " << Kernel::name << ", trial " << trial;
+    std::array<Vec<Dim>, G> x;
+    for (auto& xg : x)
+      for (int a = 0; a < Dim; ++a) xg[a] = inside(gen);
+    if (trial % 4 == 1) x[0] = Vec<Dim>::Constant(0.3);       // on a node
+    if (trial % 4 == 2) x[G - 1] = Vec<Dim>::Constant(0.35);  // half-way
+    if (trial % 4 == 3) x[0] = x[G - 1];
+    std::vector<Stencil<Dim, Kernel>> st;
+    for (const auto& xg : x) st.emplace_back(xg, geo);
+    std::array<typename Modes::Kept, G> together, alone;
+    std::memset(together.data(), 0xff, sizeof together);
+    std::memset(alone.data(), 0, sizeof alone);
+    if constexpr (G == 2) {
+      Modes::keep_pair(st[0], st[1], dx, together[0], together[1]);
+    } else {
+      const Stencil<Dim, Kernel>* stencils[G];
+      typename Modes::Kept* kept[G];
+      for (int g = 0; g < G; ++g) stencils[g] = &st[g], kept[g] = &together[g];
+      Modes::template keep_group<G, Kernel>(stencils, dx, kept);
+    }
+    for (int g = 0; g < G; ++g) {
+      Modes own;
+      own.build(st[g], dx);
+      own.keep(alone[g]);
+      EXPECT_EQ(bits(together[g]), bits(alone[g]))
+          << Dim << "D " << Kernel::name << ", " << G << " together, particle " << g << ", trial "
+          << trial;
+    }
   }
 }
 
-TEST(PolypicModes, PairBuildIsEachParticlesOwn) {
-  check_pair_build<1, QuadraticKernel>();
-  check_pair_build<1, CubicKernel>();
-  check_pair_build<2, QuadraticKernel>();
-  check_pair_build<2, CubicKernel>();
-  check_pair_build<2, CpGimpKernel>();
-  check_pair_build<3, QuadraticKernel>();
-  check_pair_build<3, CubicKernel>();
-  check_pair_build<3, CpGimpKernel>();
+TEST(PolypicModes, GroupBuildIsEachParticlesOwn) {
+  check_group_build<1, QuadraticKernel, 2>();
+  check_group_build<1, CubicKernel, 2>();
+  check_group_build<2, QuadraticKernel, 2>();
+  check_group_build<2, CubicKernel, 2>();
+  check_group_build<2, CpGimpKernel, 2>();
+  check_group_build<2, QuadraticKernel, 4>();
+  check_group_build<2, CubicKernel, 4>();
+  check_group_build<2, CpGimpKernel, 4>();
+  check_group_build<3, QuadraticKernel, 2>();
+  check_group_build<3, CubicKernel, 2>();
+  check_group_build<3, CpGimpKernel, 2>();
 }
 
 // The weighted transforms give the same bits whatever the rows' width: rows of 2
