@@ -399,9 +399,12 @@ class PolypicPolicy {
   // modes of two particles at once (keep_modes) and P2G restores them too: 2D
   // cubic 1.07-1.33x, cpGIMP 1.17-1.26x (5 rounds at 1 thread); 3D cubic, with
   // P2G fetching the records ahead (core/solver_impl.hpp), 1.19x at 1 thread and
-  // 1.15x at 2 (5 rounds). With 3 the build is cheaper than the pass's stencils
-  // and records: 2D quadratic 0.82-0.93x.
-  static constexpr bool kKeepPass = kKeepsModes && S >= 4;
+  // 1.15x at 2 (5 rounds). With 3 the build of two was cheaper than the pass's
+  // stencils and records (2D quadratic 0.82-0.93x); the build of four in one
+  // register (2D, Modes::kGroup) pays for every kernel: against pairs, 2D cubic
+  // 1.09-1.16x and cpGIMP 1.24x, and against no pass, quadratic 1.14x and uGIMP
+  // 1.30x (5 rounds at 1 thread).
+  static constexpr bool kKeepPass = kKeepsModes && (S >= 4 || Modes::kGroup == 4);
   struct KeptModes {
     typename Modes::Kept modes;
     V x;
