@@ -386,15 +386,12 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
                       policy.keep_modes(st, x, k);
                     }) {
         constexpr int G = Policy::kKeptTogether;
-        const auto stencil = [&](long p) MPMTB_INLINE_LAMBDA {
-          return StencilT(P.x[p], this->domain_F(P, p), s.grid.geo);
-        };
 #pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
         for (long a = 0; a < n; a += G) {
           // Particles a .. a + G - 1, the last one repeated past the end.
           const auto at = [&](int g) MPMTB_INLINE_LAMBDA { return std::min(a + g, n - 1); };
           [&]<int... g>(std::integer_sequence<int, g...>) MPMTB_INLINE_LAMBDA {
-            const StencilT st[G] = {stencil(at(g))...};
+            const StencilT st[G] = {StencilT(P.x[at(g)], this->domain_F(P, at(g)), s.grid.geo)...};
             const StencilT* const stencils[G] = {&st[g]...};
             const Vec<Dim>* const x[G] = {&P.x[at(g)]...};
             KeptOf<Policy>* const kept[G] = {&kept_[at(g)]...};

@@ -69,7 +69,7 @@ typedef Real AxisPack __attribute__((vector_size(4 * sizeof(Real))));
 // The lanes' square roots, in place: one vector instruction where the target has
 // it (correctly rounded, as std::sqrt; the lanes are never negative where used).
 // (A template, so that only the branch of the build's Real is compiled; also for
-// registers twice as wide as an AxisPack, PolyModes::keep_pair in 3D, which are
+// registers twice as wide as an AxisPack, PolyModes::keep_group in 3D, which are
 // never passed by value: GCC warns of their ABI on targets without AVX-512.)
 template <class Pack = AxisPack>
 inline void axis_sqrt_in_place(Pack& x) {

@@ -17,10 +17,10 @@
 
 #include "core/batch_exp.hpp"
 #include "core/batch_log.hpp"
+#include "core/lanes.hpp"
 #include "core/particles.hpp"
 #include "core/thread_split.hpp"
 #include "core/types.hpp"
-#include "core/lanes.hpp"
 
 namespace mpmtb {
 

@@ -43,7 +43,7 @@ namespace mpmtb {
 // s_r(i) = prod_a e_{r_a}(u_{i_a}) are then orthogonal under w_ip = prod_a w_a,
 // and their norms factor: sum_i w_ip s_r(i)^2 = prod_a norm(a, r_a).
 // Lanes: one register with a lane per axis (AxisPack), or one twice as wide
-// holding the axes of two particles (keep_pair in 3D).
+// holding the axes of two particles (keep_group in 3D).
 template <int Dim, int S, class Lanes = AxisPack>
 struct PolyModes {
   static constexpr int count = ipow(S, Dim);  // modes = stencil nodes
@@ -81,7 +81,7 @@ struct PolyModes {
     build_lanes(st.wk, st.dk, dx);
   }
   // The same from the weights w_a(k) and offsets (x_i - x_p)_a of node k, lane
-  // by lane: lanes hold axes, of one particle or of two (keep_pair).
+  // by lane: lanes hold axes, of one particle or of several (keep_group).
   MPMTB_INLINE void build_lanes(const Lanes (&w)[S], const Lanes (&d)[S], Real dx) {
     inv_dx = 1 / dx;
     const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
@@ -139,7 +139,7 @@ struct PolyModes {
     Real root_norm[Dim];
   };
   // From the lanes first .. first + Dim - 1 (a particle's axes).
-  // (K: the Kept of any Lanes; keep_pair's build is wider than the record's user.)
+  // (K: the Kept of any Lanes; keep_group's build is wider than the record's user.)
   template <class K>
   MPMTB_INLINE void keep(K& k, int first = 0) const {
     for (int n = 0; n < S; ++n)
@@ -206,13 +206,6 @@ struct PolyModes {
     all.build_lanes(w, d, dx);
     for (int g = 0; g < G; ++g) all.keep(*kept[g], g * L);
   }
-  // The same for two particles (the unit tests' reference).
-  template <class Kernel>
-  static void keep_pair(const Stencil<Dim, Kernel>& a, const Stencil<Dim, Kernel>& b, Real dx,
-                        Kept& kept_a, Kept& kept_b) {
-    keep_group<2, Kernel>({&a, &b}, dx, {&kept_a, &kept_b});
-  }
-
   // The stencil index (last axis fastest, as Stencil::for_each_node) of the node
   // at offset d = x_i - x_p.
   int node_index(const Vec<Dim>& d) const {

@@ -89,14 +89,10 @@ void check_group_build() {
     std::array<typename Modes::Kept, G> together, alone;
     std::memset(together.data(), 0xff, sizeof together);
     std::memset(alone.data(), 0, sizeof alone);
-    if constexpr (G == 2) {
-      Modes::keep_pair(st[0], st[1], dx, together[0], together[1]);
-    } else {
-      const Stencil<Dim, Kernel>* stencils[G];
-      typename Modes::Kept* kept[G];
-      for (int g = 0; g < G; ++g) stencils[g] = &st[g], kept[g] = &together[g];
-      Modes::template keep_group<G, Kernel>(stencils, dx, kept);
-    }
+    const Stencil<Dim, Kernel>* stencils[G];
+    typename Modes::Kept* kept[G];
+    for (int g = 0; g < G; ++g) stencils[g] = &st[g], kept[g] = &together[g];
+    Modes::template keep_group<G, Kernel>(stencils, dx, kept);
     for (int g = 0; g < G; ++g) {
       Modes own;
       own.build(st[g], dx);
