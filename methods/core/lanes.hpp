@@ -1,8 +1,8 @@
 // A per-particle formula over a vector register of particles, one particle per
 // lane (ModelBase's stress batches, G2P's failure check): F_p's entries in, one
-// pack per entry, and V0_p tau_p out. A formula written once as a template on its number
-// type T runs with T = Lanes in the batches and with T = Real for one particle,
-// the same operations in each lane, so the two give the same bits.
+// pack per entry, and V0_p tau_p out. A formula written once as a template on
+// its number type T runs with T = Lanes in the batches and with T = Real for
+// one particle, the same operations in each lane, so the two give the same bits.
 #pragma once
 
 #include <cstring>

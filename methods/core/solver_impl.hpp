@@ -73,6 +73,7 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   using Base::blocks_;
   using Base::clear_active_box;
   using Base::clear_for_unpack;
+  using Base::filter_old_velocity;
   using Base::for_each_active_node;
   using Base::for_each_active_row;
   using Base::kStressRun;
@@ -208,7 +209,8 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
       }
     }
     s.pin_impulse += Vec3(rx, ry, rz);
-    if constexpr (kFiltersOldVelocity) filter_old_velocity(s);
+    if constexpr (kFiltersOldVelocity)
+      filter_old_velocity(s, Policy(transfer_params_, g.geo.dx).old_velocity_series());
     s.walls.apply(g);
     if (!s.colliders.empty())
       s.colliders.apply(g, s.time + dt, s.collider_impulse, s.collider_work);
@@ -498,61 +500,6 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
     }
   }
 
-  // v_old <- sum_j c_j Q^j v_old, c = the policy's old_velocity_series(), with
-  // Q = S+ S the particle projection of a nodal field: interpolate it to the
-  // particles (S, u_p = sum_i w_ip u_i), scatter it back mass-weighted
-  // (S+, u_i = sum_p w_ip m_p u_p / sum_p w_ip m_p). Both go through the fast
-  // path's tensor-product sums, as a PIC form (node by node, the scatter took 40 %
-  // of XPIC(5)'s step). The scatter runs over P2G's blocks and colours (the
-  // particles have not moved since), so the result does not depend on the thread
-  // count. Particles and nodes as in this step's P2G.
-  void filter_old_velocity(State<Dim>& s) {
-    Grid<Dim>& g = s.grid;
-    const Particles<Dim>& P = s.particles;
-    const std::vector<Real> c = Policy(transfer_params_, g.geo.dx).old_velocity_series();
-    const long n = static_cast<long>(P.size());
-    if (c.size() > 1) {
-      q_field_.resize(g.size()), q_sum_.resize(g.size()), q_mass_.resize(g.size());
-      q_sums_.resize(g.size());
-      q_particle_.resize(n);
-    }
-    for_each_active_node(g, [&](long i) {
-      if (c.size() > 1) q_field_[i] = g.v_old[i];
-      g.v_old[i] *= c[0];
-    });
-    for (std::size_t j = 1; j < c.size(); ++j) {
-      pack_velocities(v_rows_, g, q_field_.data(), nullptr);
-#pragma omp parallel for schedule(static) if (n >= kParallelMinimum)
-      for (long p = 0; p < n; ++p) {
-        q_particle_[p] = TensorTransfer<Dim, Kernel>::template gather<TensorTerms{}>(
-                             StencilT(P.x[p], this->domain_F(P, p), g.geo), g.geo, v_rows_.data())
-                             .v;
-      }
-      // (sum_i w_ip m_p, sum_i w_ip m_p u_p) as P2G's fast path sums a PIC form,
-      // into rows of (m, m u) (folded sums without a force).
-      blocks_.for_each_coloured(s, [&](int p) {
-        using Form = ScatterForm<Dim>;
-        Form form;
-        form.alpha[Form::m] = P.m[p];
-        form.alpha.template segment<Dim>(Form::p) = P.m[p] * q_particle_[p];
-        TensorTransfer<Dim, Kernel>::template scatter_folded<TensorTerms{}>(
-            StencilT(P.x[p], this->domain_F(P, p), g.geo), g.geo, form, 0, q_sums_.data());
-      });
-      for_each_active_row(g, [&](long first, long count) {
-        q_sums_.template unpack<true, true>(first, count, q_mass_.data(), q_sum_.data(), nullptr);
-      });
-      // A pass of its own: fused into the unpack's row loop it measured 0.96x.
-      for_each_active_node(g, [&](long i) {
-        if (q_mass_[i] > 0) {
-          q_field_[i] = q_sum_[i] / q_mass_[i];
-        } else {
-          q_field_[i].setZero();
-        }
-        g.v_old[i] += c[j] * q_field_[i];
-      });
-    }
-  }
-
   Parameters transfer_params_;
   // The fast path's G2P input: v (and v_old if the policy reads it) for the
   // transfer's gather (v alone for the F update and XPIC's filter: v_rows_).
@@ -568,10 +515,6 @@ class Solver final : public SolverStages<Dim, Kernel, folds_force<Dim, Kernel, T
   StealingShares gather_shares_;  // taken in chunks of kChunk, the last ones stolen
   // G2P's chunks: whole runs, few enough that taking one costs nothing.
   static constexpr long kChunk = 16 * kRun;
-  // Scratch of filter_old_velocity: nodal field, sums and masses; particle values.
-  std::vector<Vec<Dim>> q_field_, q_sum_, q_particle_;
-  std::vector<Real> q_mass_;
-  NodeSums<Dim, true> q_sums_;  // the scatter's (m, m u) rows, zero between scatters
   // The policy's values kept from the last scatter for G2P, and whether they
   // are that scatter's (no G2P since).
   std::vector<KeptOf<Policy>> kept_;

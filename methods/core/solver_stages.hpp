@@ -1,9 +1,9 @@
 // The stages of a step that do not depend on the transfer scheme, compiled once
 // per dimension, kernel and layout of the P2G sums (core/solver_stages_*d.cpp)
 // instead of once per transfer: the gradient-based force scatter and F update
-// of the split orders (usf, musl), the grid velocities that update F, the
-// stresses, the scatter's bookkeeping (binning, clearing and unpacking the sums)
-// and the nonlocal Laplacian. Each transfer's Solver (core/solver_impl.hpp)
+// of the split orders (usf, musl), the grid velocities that update F, XPIC's
+// filter of v_old, the stresses, the scatter's bookkeeping (binning, clearing
+// and unpacking the sums) and the nonlocal Laplacian. Each transfer's Solver (core/solver_impl.hpp)
 // derives from this class and adds its own P2G, grid update and G2P. Only the
 // declarations are here, so that a transfer's file does not compile these
 // stages again (core/solver_stages_impl.hpp holds the definitions).
@@ -77,6 +77,9 @@ class SolverStages : public Stepper<Dim> {
   // the sums then zeroed (drained) or kept for scatter_forces.
   [[gnu::noinline]] void unpack_and_drain(Grid<Dim>& g);
   [[gnu::noinline]] void unpack_and_keep(Grid<Dim>& g);
+  // v_old <- sum_j c_j Q^j v_old over the active box, Q the particle projection
+  // (XPIC: the policy's old_velocity_series(); after P2G, before the particles move).
+  [[gnu::noinline]] void filter_old_velocity(State<Dim>& s, const std::vector<Real>& c);
 
   // The form into the P2G sums, folded with dt or not (kFold).
   template <TensorTerms T>
@@ -147,6 +150,10 @@ class SolverStages : public Stepper<Dim> {
   std::vector<Real> m_kept_;  // grid_velocities: m and p before the walls fold them
   std::vector<Vec<Dim>> p_kept_;
   NonlocalLaplacian<Dim, Kernel> nonlocal_;
+  // Scratch of filter_old_velocity: nodal field, sums and masses; particle values.
+  std::vector<Vec<Dim>> q_field_, q_sum_, q_particle_;
+  std::vector<Real> q_mass_;
+  NodeSums<Dim, true> q_sums_;  // the scatter's (m, m u) rows, zero between scatters
 };
 
 }  // namespace mpmtb
