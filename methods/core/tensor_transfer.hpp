@@ -546,6 +546,34 @@ class TensorTransfer {
         if constexpr (T.moment) acc.Dm[a] = L::fma(md[a], row, acc.Dm[a]);
         if constexpr (T.gradient) acc.Gr[a] = L::fma(gd[a], row, acc.Gr[a]);
       }
+    } else if constexpr (Dim == 3 && A == 0) {
+      // 3D: each slab k of the first axis summed over the second with that
+      // axis's own factors, then the slabs' sums added with the first axis's:
+      // per row a fused multiply-add per sum of the second axis and register,
+      // its factor splat from the stencil, where the products of the two axes'
+      // factors had to be formed and splat for every row (the same sums
+      // associated otherwise; 3D block, 1 thread: see CHANGELOG).
+      const L zero = L::from([](int) MPMTB_INLINE_LAMBDA { return Real(0); });
+      for (int k = 0; k < S; ++k) {
+        L sW = zero, sM = zero, sG = zero;  // the slab's sums over the second axis
+        for (int k1 = 0; k1 < S; ++k1) {
+          const long n = node + k * stride[0] + k1 * stride[1];
+          const L row = L::load(rows + n * N);
+          if constexpr (T.nodal) row.store(nodal + (k * S + k1) * S * N);
+          sW = L::fma(st.w(1, k1), row, sW);
+          if constexpr (T.moment) sM = L::fma(wd[k1][1], row, sM);
+          if constexpr (T.gradient) sG = L::fma(st.dw(1, k1), row, sG);
+        }
+        acc.W = L::fma(st.w(0, k), sW, acc.W);
+        if constexpr (T.moment) {
+          acc.Dm[0] = L::fma(wd[k][0], sW, acc.Dm[0]);
+          acc.Dm[1] = L::fma(st.w(0, k), sM, acc.Dm[1]);
+        }
+        if constexpr (T.gradient) {
+          acc.Gr[0] = L::fma(st.dw(0, k), sW, acc.Gr[0]);
+          acc.Gr[1] = L::fma(st.w(0, k), sG, acc.Gr[1]);
+        }
+      }
     } else if constexpr (A == Dim - 2) {
       // The last leading axis: the factors of its S rows at once, row k in lane
       // k (the same products as below, lane by lane), then splat into each
