@@ -153,7 +153,8 @@ struct Row {
 // axis (W per node, consecutive in memory), as the fewest registers of at most 32
 // bytes: the widest packs first, then narrower ones (12 doubles: 4 + 4 + 4, 12
 // floats: 8 + 4). The transfers' last axis works on whole strips, so a row of
-// nodes costs one load, one add and one store per register instead of per node.
+// nodes costs a load, a fused multiply-add per term and a store per register
+// instead of per node.
 // (With AVX-512, 8 + 4 doubles measured 4 % slower on the 3D block than 4 + 4 + 4,
 // likely because the next particle's stencil row, a node further on, loads across
 // two of the previous one's stores, which a core cannot forward; G2P's strips,

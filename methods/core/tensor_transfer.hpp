@@ -445,7 +445,8 @@ class TensorTransfer {
   using VR = VelocityRows<Dim, T.old>;
   // The gather by stencil rows (Strip): first the sums over the leading axes of
   // whole rows, each row weighted by the product of the leading axes' factors
-  // (w_a, or w_a d_a / dw_a for the moment / gradient along axis a), then each
+  // (w_a, or w_a d_a / dw_a for the moment / gradient along axis a; in 3D by
+  // slabs, the second axis's factors first and then the first's), then each
   // sum reduced along the last axis with its factors. The same sums as node by
   // node, added in another order; a row costs a load and one fused multiply-add
   // per sum and register.
