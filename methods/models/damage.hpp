@@ -352,11 +352,12 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     for (int first = 0; first < count; first += L) {
       const int n = std::min(L, count - first);
       Lanes F[Dim][Dim], d{}, lap{}, diag{};
+      // F by transposes where a whole register's particles are there (core/lanes.hpp;
+      // the identity in the lanes past the end, which are not read).
+      load_lanes<Dim>(P.F, ids + first, n, F);
       for (int k = 0; k < L; ++k) {
         const int p = ids[first + std::min(k, n - 1)];  // the last one again past the end
         const Real* q = P.state_of(p);
-        for (int i = 0; i < Dim; ++i)
-          for (int j = 0; j < Dim; ++j) F[i][j][k] = P.F[p](i, j);
         d[k] = q[kDamage], lap[k] = q[kLapDamage], diag[k] = q[kLapDiagonal];
       }
       const Lanes det = determinant_of<Dim>(F);  // Eigen's, lane by lane

@@ -202,6 +202,45 @@ void expect_local_equals_whole(int cells, const Vec<Dim>& centre, Real radius) {
   }
 }
 
+// A field zero everywhere: every particle of a requesting material takes lap_p
+// = +0 and the operator's diagonal, and no other particle's state is written.
+// With one material (every request the same: source_nodes' sweep over the state
+// records alone) and with a second, elastic one beside it (the sweep by material).
+TEST(NonlocalLaplacian, ZeroFieldWritesTheRequestingParticlesOnly) {
+  const std::string elastic_body =
+      "[materials.e]\nmodel = \"neo-hookean\"\nE = 1e4\nnu = 0.3\ndensity = 1000.0\n"
+      "[[bodies]]\nshape = \"box\"\nmin = [0.05, 0.05, 0.05]\nmax = [0.15, 0.95, 0.95]\n"
+      "material = \"e\"\n";
+  for (const bool two_materials : {false, true}) {
+    const Scene scene = testing::scene_from_toml(
+        block_toml(2, 32, "quadratic") + (two_materials ? elastic_body : ""), {.dim = 2});
+    State<2> s = build_state<2>(scene);
+    auto& P = s.particles;
+    const int damage = s.materials[0]->laplacian_request().active() ? 0 : 1;
+    int requested = 0, others = 0;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      for (int k = 0; k < P.state_size; ++k) P.state_of(p)[k] = -1;
+      if (P.material[p] == damage) P.state_of(p)[0] = 0;
+    }
+    NonlocalLaplacian<2, QuadraticKernel> op;
+    op.apply(s);
+    const Real dx = s.grid.geo.dx;
+    for (std::size_t p = 0; p < P.size(); ++p) {
+      const Real* q = P.state_of(p);
+      if (P.material[p] == damage) {
+        ASSERT_EQ(std::bit_cast<std::uint64_t>(double(q[2])), 0u) << "particle " << p;
+        ASSERT_EQ(q[3], 4 / (dx * dx)) << "particle " << p;
+        ++requested;
+      } else {
+        for (int k = 0; k < P.state_size; ++k) ASSERT_EQ(q[k], -1) << "particle " << p;
+        ++others;
+      }
+    }
+    EXPECT_GT(requested, 0);
+    EXPECT_EQ(others > 0, two_materials);
+  }
+}
+
 TYPED_TEST(NonlocalLaplacianTest, LocalOperatorEqualsTheWholeOneBitForBit) {
   expect_local_equals_whole<2, TypeParam>(32, Vec<2>(0.5, 0.45), 0.08);
   expect_local_equals_whole<2, TypeParam>(32, Vec<2>(0.2, 0.8), 0.1);  // the body's corner
