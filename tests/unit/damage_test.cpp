@@ -6,6 +6,7 @@
 #include <bit>
 #include <cmath>
 #include <cstdint>
+#include <limits>
 #include <map>
 #include <numbers>
 #include <random>
@@ -272,6 +273,55 @@ TYPED_TEST(DamageTest, StressExcessHasTheSolversSign) {
     EXPECT_GT(positive, 500);
     EXPECT_GT(negative, 500);
   }
+}
+
+// The largest eigenvalue in 3D in closed form (Damage::largest_eigenvalue_3x3)
+// is Eigen's iterative solver's to a few eps |A|, at every scale, with eigenvalues
+// spread, the two smallest repeated or nearly so, nearly a multiple of I and
+// exactly one; where the two largest nearly coincide the solver answers.
+TEST(DamageEigenvalue, ClosedFormAgreesWithTheIterativeSolver) {
+  std::mt19937 gen(2026);
+  std::uniform_real_distribution<Real> u(-1, 1);
+  constexpr Real eps = std::numeric_limits<Real>::epsilon();
+  int closed = 0, solved = 0;
+  for (int trial = 0; trial < 20000; ++trial) {
+    const Real scale = std::pow(Real(10), 6 * u(gen));
+    const Real gap = std::pow(Real(10), -8 * (u(gen) + 1));  // 1 down to 1e-16
+    Vec<3> lambda;
+    switch (trial % 5) {
+      case 0:
+        lambda << u(gen), u(gen), u(gen);
+        break;
+      case 1:
+        lambda << 1, -0.5, -0.5 - gap;
+        break;  // the two smallest close
+      case 2:
+        lambda << 1, 1 - gap, u(gen) - 1.5;
+        break;  // the two largest close
+      case 3:
+        lambda << 5 + gap, 5, 5 - gap;
+        break;  // nearly a multiple of I
+      default:
+        lambda << 2, 2, 2;
+        break;  // a multiple of I
+    }
+    const Mat<3> R = RandomRotation<3>(gen);
+    const Mat<3> A = scale * R * lambda.asDiagonal() * R.transpose();
+    const Mat<3> sym = Real(0.5) * (A + A.transpose());
+    Eigen::SelfAdjointEigenSolver<Mat<3>> eig(sym, Eigen::EigenvaluesOnly);
+    const Real reference = eig.eigenvalues().maxCoeff();
+    Real largest = 0;
+    if (Damage<3>::largest_eigenvalue_3x3(sym, largest)) {
+      ASSERT_NEAR(largest, reference, 16 * eps * sym.norm()) << "trial " << trial;
+      ++closed;
+    } else {
+      ++solved;
+    }
+    ASSERT_NEAR(Damage<3>::max_symmetric_eigenvalue(A), reference, 16 * eps * sym.norm())
+        << "trial " << trial;
+  }
+  EXPECT_GT(closed, 15000);
+  EXPECT_GT(solved, 1000) << "the two largest close: the solver's";
 }
 
 // project() skips the exact driver where an exp-free bound shows the stress
