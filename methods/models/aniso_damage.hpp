@@ -258,6 +258,16 @@ class AnisoDamage final : public ModelBase<Dim, AnisoDamage<Dim>> {
                       (fiber_degradation(d_old) - fiber_degradation(d_new)) * fiber_energy(F, q);
     q[kDamage] = d_new;
   }
+  // The same with s = J^(2/3) given (3D; ModelBase::return_map takes a batch's
+  // exponentials): at alpha = 0 without fibres `damage`'s own, bit for bit; with
+  // them the path above (s is not read).
+  static constexpr Real kPowerOfLog = Matrix::kPowerOfLog;
+  void project_given_log_and_power(Mat<Dim>& F, Real logJ, Real s, Real* q, Real dt) const
+      requires(Dim == 3) {
+    if (alpha_ != 0 || fiber_E_ != 0) return project_given_log(F, logJ, q, dt);
+    advect_fibers(F, q);
+    m_.project_given_log_and_power(F, logJ, s, q, dt);
+  }
   Real dissipated(const Real* q) const { return q[kDissipated]; }
 
   // Undegraded fibre energy, first Piola and Kirchhoff stress (sum over families).

@@ -133,7 +133,11 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     Real plus = 0, minus = 0;
   };
   Split split(const Mat<Dim>& F) const {
-    const Real J = F.determinant(), logJ = std::log(J), s = pow_2_over_dim(J, logJ);
+    const Real J = F.determinant(), logJ = std::log(J);
+    return split(F, J, logJ, pow_2_over_dim(J, logJ));
+  }
+  // The same with J, ln J and s = J^(2/dim) given.
+  Split split(const Mat<Dim>& F, Real J, Real logJ, Real s) const {
     // Rounding can leave tr C - dim s a few ulps below its bound 0.
     const Real dev = std::max(Real(0), Real(0.5) * c_.mu * ((F.transpose() * F).trace() - Dim * s));
     const Real vol =
@@ -208,9 +212,13 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
     return undamaged_cauchy(F, std::log(F.determinant()));
   }
   Mat<Dim> undamaged_cauchy(const Mat<Dim>& F, Real logJ) const {
+    return undamaged_cauchy(F, logJ, pow_2_over_dim(F.determinant(), logJ));
+  }
+  // The same with s = J^(2/dim) given.
+  Mat<Dim> undamaged_cauchy(const Mat<Dim>& F, Real logJ, Real s) const {
     const Real J = F.determinant();
     Mat<Dim> sigma;
-    tau_entries(F, logJ, 1, [&](int i, int j, Real t) { sigma(i, j) = t / J; });
+    tau_entries(F, logJ, s, 1, [&](int i, int j, Real t) { sigma(i, j) = t / J; });
     return sigma;
   }
   Real max_principal_stress(const Mat<Dim>& F) const {
@@ -337,12 +345,32 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   // The same with ln J given: the return map takes the logarithms of a batch at
   // once (ModelBase::return_map).
   void project_given_log(Mat<Dim>& F, Real logJ, Real* q, Real dt) const {
+    project_by(
+        F, logJ, q, dt, [&] { return stress_excess(F, logJ); }, [&] { return split(F).plus; });
+  }
+  // The same with s = J^(2/3) given too: the return map takes the exponentials
+  // of a batch at once (ModelBase::return_map) where project_given_log took two
+  // scalar ones, for the driver's stress and for the split (perf: 5 % of the
+  // tearing pinned block). The batch's ln J and s round as core/batch_log.hpp
+  // and core/batch_exp.hpp do, within an ulp of std::log and std::exp.
+  void project_given_log_and_power(Mat<Dim>& F, Real logJ, Real s, Real* q, Real dt) const
+      requires(Dim == 3) {
+    project_by(
+        F, logJ, q, dt,
+        [&] { return eigenvalue_excess(undamaged_cauchy(F, logJ, s), sigma_crit_); },
+        [&] { return split(F, F.determinant(), logJ, s).plus; });
+  }
+  // The damage update from the excess sigma_max - sigma_crit and the tensile
+  // energy psi+, each computed only where needed.
+  template <class Excess, class Plus>
+  void project_by(const Mat<Dim>& F, Real logJ, Real* q, Real dt, Excess&& excess_of,
+                  Plus&& plus_of) const {
     const Real d_old = q[kDamage];
     if (d_old >= 1) return;
-    const Real excess = certainly_below_limit(F, logJ) ? -sigma_crit_ : stress_excess(F, logJ);
+    const Real excess = certainly_below_limit(F, logJ) ? -sigma_crit_ : excess_of();
     const Real d_new = advanced_damage(d_old, excess, q, dt);
     if (!(d_new > d_old)) return;
-    q[kDissipated] += (degradation(d_old) - degradation(d_new)) * split(F).plus;
+    q[kDissipated] += (degradation(d_old) - degradation(d_new)) * plus_of();
     q[kDamage] = d_new;
   }
   // True when sigma_max < sigma_crit (1 - 1e-9) is certain from a bound that

@@ -143,23 +143,35 @@ class ModelBase : public ConstitutiveModel<Dim> {
     }
   }
   void return_map(Particles<Dim>& particles, std::span<const int> ids, Real dt) const override {
-    if constexpr (requires(Mat<Dim> & F, Real * q) { self().project_given_log(F, 0, q, dt); }) {
+    // A projection that takes exp(kPowerOfLog ln J) too (Damage in 3D: J^(2/3))
+    // gets it from the batch's exponentials (core/batch_exp.hpp), as ln J from
+    // its logarithms.
+    constexpr bool kPower = requires(Mat<Dim> & F, Real * q) {
+      self().project_given_log_and_power(F, 0, 1, q, dt);
+    };
+    if constexpr (kPower ||
+                  requires(Mat<Dim> & F, Real * q) { self().project_given_log(F, 0, q, dt); }) {
+      const auto project = [&](int p, Real logJ, Real power) {
+        if constexpr (kPower) {
+          self().project_given_log_and_power(particles.F[p], logJ, power, particles.state_of(p),
+                                             dt);
+        } else {
+          self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
+        }
+      };
       // A model that can tell from F, J and its state that its return map leaves
       // a particle as it is (Damage::unsettled: the undamaged stress below the
       // threshold, a vector register of particles at a time) spares that
       // particle's logarithm and call.
-      const auto project = [&](int p, Real logJ) {
-        self().project_given_log(particles.F[p], logJ, particles.state_of(p), dt);
-      };
       if constexpr (requires(const int* batch, Real* J, int* kept) {
                       self().unsettled(particles, batch, 0, dt, J, kept);
                     }) {
-        for_each_with_log(particles, ids, project,
-                          [&](const int* batch, int count, Real* J, int* kept) {
-                            return self().unsettled(particles, batch, count, dt, J, kept);
-                          });
+        for_each_with_log<kPower>(particles, ids, project,
+                                  [&](const int* batch, int count, Real* J, int* kept) {
+                                    return self().unsettled(particles, batch, count, dt, J, kept);
+                                  });
       } else {
-        for_each_with_log(particles, ids, project);
+        for_each_with_log<kPower>(particles, ids, project);
       }
     } else if constexpr (requires(Mat<Dim> & F, Real * q) { self().project(F, q, dt); }) {
       const long n = static_cast<long>(ids.size());
@@ -190,23 +202,25 @@ class ModelBase : public ConstitutiveModel<Dim> {
   // Batches a thread takes at a time in for_each_chunk_balanced (256 particles:
   // 64 chunks per thread for the 32,768 particles of the 3D block at 2 threads).
   static constexpr long kLogChunk = 4;
-  // f(p, ln det F_p) for every particle p of ids but those a skip screens out
-  // (skip(ids, count, J, kept) writes det F and the ids of the particles kept
+  // f(p, ln det F_p, power) for every particle p of ids but those a skip screens
+  // out (skip(ids, count, J, kept) writes det F and the ids of the particles kept
   // of a batch, and returns their count), in parallel over batches of
   // kLogBatch: each batch's logarithms first, in vector registers
-  // (core/batch_log.hpp), then f for its particles. For the return maps that
-  // need ln J (project_given_log); the stress batches take with_log directly.
-  // (batch_log's lanes are independent: a value's logarithm does not depend on
-  // the batch it is in, so neither does a stress, which P2G computes in runs of
-  // its scatter's order: kirchhoff_times_volume_of.)
+  // (core/batch_log.hpp), with kPower power = exp(Derived::kPowerOfLog ln det
+  // F_p) likewise (core/batch_exp.hpp), else 1; then f for its particles. For
+  // the return maps that need ln J (project_given_log[_and_power]); the stress
+  // batches take with_log directly. (batch_log's lanes are independent: a
+  // value's logarithm does not depend on the batch it is in, so neither does a
+  // stress, which P2G computes in runs of its scatter's order:
+  // kirchhoff_times_volume_of.)
   struct NoSkip {};
-  template <class F, class Skip = NoSkip>
+  template <bool kPower = false, class F, class Skip = NoSkip>
   static void for_each_with_log(const Particles<Dim>& particles, std::span<const int> ids, F&& f,
                                 Skip&& skip = {}) {
     for_each_batch(static_cast<long>(ids.size()), [&](long first, int count) {
-      with_log(
+      with_log<kPower>(
           particles, &ids[first], count,
-          [&](int, int p, Real logJ, Real) MPMTB_INLINE_LAMBDA { f(p, logJ); }, skip);
+          [&](int, int p, Real logJ, Real power) MPMTB_INLINE_LAMBDA { f(p, logJ, power); }, skip);
     });
   }
   // f(first, count) for each batch of kLogBatch of n particles, in parallel.

@@ -355,6 +355,44 @@ TYPED_TEST(DamageTest, ScreenedDriverGivesTheExactDriversDamage) {
   EXPECT_GT(grown, 300) << "and the exact driver where damage grows";
 }
 
+// The return map's projection with J^(2/3) given (3D: the batch's exponentials,
+// ModelBase::return_map) is project()'s: given std::exp's J^(2/3), bit for bit;
+// through the whole return map (batch_log, batch_exp) within round-off.
+TEST(Damage3D, ProjectionWithThePowerGivenIsProjects) {
+  const Damage<3> m = MakeDamage<3>();
+  constexpr Real dt = 1e-4;
+  std::mt19937 gen(16);
+  Particles<3> P, expected;
+  P.state_size = expected.state_size = 4;
+  int grown = 0;
+  for (int trial = 0; trial < 3000; ++trial) {
+    const Mat<3> F = testing::RandomF<3>(gen, 0.05 + 0.1 * (trial % 5), 0.3);
+    const Real logJ = std::log(F.determinant()), d_old = trial % 3 == 0 ? 0.4 : 0;
+    Real q[4] = {d_old, 0.25, 0, 0}, reference[4] = {d_old, 0.25, 0, 0};
+    Mat<3> G = F, H = F;
+    m.project_given_log_and_power(G, logJ, std::exp(Real(2) / 3 * logJ), q, dt);
+    m.project_given_log(H, logJ, reference, dt);
+    ASSERT_EQ(q[0], reference[0]) << "trial " << trial;
+    ASSERT_EQ(q[1], reference[1]) << "trial " << trial;
+    grown += reference[0] > d_old;
+    for (Particles<3>* to : {&P, &expected}) {
+      to->add(Vec<3>::Zero(), Vec<3>::Zero(), 1, 1, 0);
+      to->F.back() = F;
+      for (const Real v : {d_old, Real(0.25), Real(0), Real(0)}) to->state.push_back(v);
+    }
+  }
+  EXPECT_GT(grown, 300);
+  std::vector<int> ids(P.size());
+  for (std::size_t p = 0; p < ids.size(); ++p) ids[p] = static_cast<int>(p);
+  m.return_map(P, ids, dt);
+  for (std::size_t p = 0; p < P.size(); ++p) {
+    m.project(expected.F[p], expected.state_of(p), dt);
+    for (int k : {0, 1}) {
+      ASSERT_NEAR(P.state_of(p)[k], expected.state_of(p)[k], 1e-13) << "particle " << p;
+    }
+  }
+}
+
 // settled() lets the return map skip a particle (and its logarithm): only
 // where project() would leave it exactly as it is, including the growth that
 // the nonlocal term alone drives (l0 > 0, lap d > 0 from damaged neighbours).
