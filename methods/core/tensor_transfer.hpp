@@ -346,8 +346,7 @@ class TensorTransfer {
       if constexpr (T.moment) acc.Dm[a] = acc.W;
       if constexpr (T.gradient) acc.Gr[a] = acc.W;
     }
-    Real md[Dim] = {}, gd[Dim] = {};
-    prefix_rows<0, T>(st, wd, stride, st.base_node, 0, rows, nodal, Real(1), md, gd, acc);
+    row_sums<T>(st, wd, stride, rows, nodal, acc);
     out.W = reduce_last<GR>(acc.W, st.wk);
     for (int a = 0; a < B; ++a) {
       if constexpr (T.moment) out.Dm[a] = reduce_last<GR>(acc.Dm[a], st.wk);
@@ -385,8 +384,8 @@ class TensorTransfer {
       return __builtin_shufflevector(f01, f23, 0, 1, 4, 5);
     }
   }
-  // Row K of the last leading axis (prefix_rows): its factors in lane K of w,
-  // md and gd.
+  // Row K of the first axis in 2D (row_sums): its factors in lane K of w, md
+  // and gd.
   template <int K, TensorTerms T>
   MPMTB_INLINE static void last_row(long node, int j, const Real* __restrict rows,
                                     Real* __restrict nodal, const AxisPack& w,
@@ -402,32 +401,40 @@ class TensorTransfer {
       if constexpr (T.gradient) acc.Gr[a] = L::template fma_lane<K>(gd[a], row, acc.Gr[a]);
     }
   }
-  // Axis A < Dim - 1 of the rows' prefix: w = prod_{b<A} w_b, md[a] (gd[a]) the
-  // same product with w_a d_a (dw_a) for axis a < A; j the stencil index of the
-  // axes before A.
-  template <int A, TensorTerms T>
-  MPMTB_INLINE static void prefix_rows(const St& st, const AxisPack (&wd)[S],
-                                       const std::array<long, Dim>& stride, long node, int j,
-                                       const Real* __restrict rows, Real* __restrict nodal, Real w,
-                                       const Real (&md)[Dim], const Real (&gd)[Dim],
-                                       RowSums<T>& acc) {
+  // The sums over the stencil's rows (RowSums), each row copied to nodal with
+  // T.nodal (row j at nodal + j S N): in 1D the one row; in 2D the S rows of
+  // the first axis (last_row); in 3D by slabs of the first axis.
+  template <TensorTerms T>
+  MPMTB_INLINE static void row_sums(const St& st, const AxisPack (&wd)[S],
+                                    const std::array<long, Dim>& stride,
+                                    const Real* __restrict rows, Real* __restrict nodal,
+                                    RowSums<T>& acc) {
     using L = typename RowSums<T>::L;
     constexpr int N = VR<T>::N;
-    if constexpr (A == Dim - 1) {
+    const long node = st.base_node;
+    if constexpr (Dim == 1) {
       const L row = L::load(rows + node * N);
-      if constexpr (T.nodal) row.store(nodal + j * S * N);
-      acc.W = L::fma(w, row, acc.W);
-      for (int a = 0; a < A; ++a) {
-        if constexpr (T.moment) acc.Dm[a] = L::fma(md[a], row, acc.Dm[a]);
-        if constexpr (T.gradient) acc.Gr[a] = L::fma(gd[a], row, acc.Gr[a]);
+      if constexpr (T.nodal) row.store(nodal);
+      acc.W = L::fma(Real(1), row, acc.W);
+    } else if constexpr (Dim == 2) {
+      // The factors of the S rows at once, row k in lane k, then splat into
+      // each row's sums: the per-row scalars had gone through the stack.
+      const AxisPack wv = axis_factors<0>(st.wk);
+      AxisPack mdv[Dim], gdv[Dim];
+      if constexpr (T.moment) mdv[0] = axis_factors<0>(wd);
+      if constexpr (T.gradient) gdv[0] = axis_factors<0>(st.dwk);
+      [&]<int... k>(std::integer_sequence<int, k...>) MPMTB_INLINE_LAMBDA {
+        (last_row<k, T>(node + k * stride[0], k, rows, nodal, wv, mdv, gdv, acc), ...);
       }
-    } else if constexpr (Dim == 3 && A == 0) {
-      // 3D: each slab k of the first axis summed over the second with that
-      // axis's own factors, then the slabs' sums added with the first axis's:
-      // per row a fused multiply-add per sum of the second axis and register,
-      // its factor splat from the stencil, where the products of the two axes'
-      // factors had to be formed and splat for every row (the same sums
-      // associated otherwise; 3D block, 1 thread: see CHANGELOG).
+      (std::make_integer_sequence<int, S>{});
+    } else {
+      static_assert(Dim == 3);
+      // Each slab k of the first axis summed over the second with that axis's
+      // own factors, then the slabs' sums added with the first axis's: per row a
+      // fused multiply-add per sum of the second axis and register, its factor
+      // splat from the stencil, where the products of the two axes' factors had
+      // to be formed and splat for every row (the same sums associated
+      // otherwise; 3D block, 1 thread: see CHANGELOG).
       const L zero = L::from([](int) MPMTB_INLINE_LAMBDA { return Real(0); });
       for (int k = 0; k < S; ++k) {
         L sW = zero, sM = zero, sG = zero;  // the slab's sums over the second axis
@@ -448,36 +455,6 @@ class TensorTransfer {
           acc.Gr[0] = L::fma(st.dw(0, k), sW, acc.Gr[0]);
           acc.Gr[1] = L::fma(st.w(0, k), sG, acc.Gr[1]);
         }
-      }
-    } else if constexpr (A == Dim - 2) {
-      // The last leading axis: the factors of its S rows at once, row k in lane
-      // k (the same products as below, lane by lane), then splat into each
-      // row's sums: the per-row scalars had gone through the stack.
-      const AxisPack wA = axis_factors<A>(st.wk);
-      const AxisPack wv = w * wA;
-      AxisPack mdv[Dim], gdv[Dim];
-      for (int a = 0; a < A; ++a) {
-        if constexpr (T.moment) mdv[a] = md[a] * wA;
-        if constexpr (T.gradient) gdv[a] = gd[a] * wA;
-      }
-      if constexpr (T.moment) mdv[A] = w * axis_factors<A>(wd);
-      if constexpr (T.gradient) gdv[A] = w * axis_factors<A>(st.dwk);
-      [&]<int... k>(std::integer_sequence<int, k...>) MPMTB_INLINE_LAMBDA {
-        (last_row<k, T>(node + k * stride[A], j * S + k, rows, nodal, wv, mdv, gdv, acc), ...);
-      }
-      (std::make_integer_sequence<int, S>{});
-    } else {
-      for (int k = 0; k < S; ++k) {
-        const Real wk = st.w(A, k);
-        Real md2[Dim], gd2[Dim];
-        for (int a = 0; a < A; ++a) {
-          if constexpr (T.moment) md2[a] = md[a] * wk;
-          if constexpr (T.gradient) gd2[a] = gd[a] * wk;
-        }
-        if constexpr (T.moment) md2[A] = w * wd[k][A];
-        if constexpr (T.gradient) gd2[A] = w * st.dw(A, k);
-        prefix_rows<A + 1, T>(st, wd, stride, node + k * stride[A], j * S + k, rows, nodal, w * wk,
-                              md2, gd2, acc);
       }
     }
   }
