@@ -220,12 +220,14 @@ class NonlocalLaplacian {
     // lookup per particle: while the field is zero everywhere (before the first
     // crack) it is all the operator does, and with the lookups and first nodes
     // it was 3.7 % of the pinned block's step.
-    if (const LaplacianRequest* r = common_request()) {
-      if (!any_source_written(P, *r, diagonal)) return NodeBox<Dim>{};
-    }
+    // Where it finds q_p != 0, the first nodes below read q_p alone (the sweep
+    // wrote the rest).
+    const LaplacianRequest* common = common_request();
+    if (common && !any_source_written(P, *common, diagonal)) return NodeBox<Dim>{};
     const auto range = first_node_range<Dim, Kernel>(
         s.grid.geo, static_cast<long>(P.size()),
         [&](long p) {
+          if (common) return P.state_of(p)[common->source] != 0;
           if (!requested(P, p)) return false;
           Real* q = P.state_of(p);
           const LaplacianRequest& r = requests_[P.material[p]];
