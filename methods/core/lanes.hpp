@@ -158,6 +158,42 @@ MPMTB_INLINE inline void load_vector_lanes(const Vec<Dim>* v, Lanes (&out)[Dim])
   }
 }
 
+// out[e] lane l = record_l[e], e < 4, for the records record_l = base + ids[l]
+// stride of a whole register of particles (each record at least 4 Reals: a
+// model's state, Particles::state_of): rows of 4 Reals paired into registers of
+// 8 and transposed in 8 shuffles per 8 lanes. (Lane by lane, three values a
+// particle, the loads and inserts were a third of the damage screen's
+// instructions.)
+// (A template: instantiated only where kRecordTransposes.)
+inline constexpr bool kRecordTransposes = kLanes % 8 == 0 && kLanes <= 16;
+template <class L = Lanes>
+MPMTB_INLINE inline void load_record_lanes(const Real* base, long stride, const int* ids,
+                                           L (&out)[4]) {
+  static_assert(kRecordTransposes);
+  using Four = typename PackOf<4 * sizeof(Real)>::type;
+  Eight entries[4][kEights];
+  for (int b = 0; b < kEights; ++b) {
+    const int* at = ids + 8 * b;
+    Eight pair[4];  // records i and i + 4 side by side
+    for (int i = 0; i < 4; ++i) {
+      Four lo, hi;
+      std::memcpy(&lo, base + at[i] * stride, sizeof lo);
+      std::memcpy(&hi, base + at[i + 4] * stride, sizeof hi);
+      pair[i] = __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7);
+    }
+    // Entries (0, 2) and (1, 3) of records (0, 1 | 4, 5) and (2, 3 | 6, 7).
+    const Eight t0 = __builtin_shufflevector(pair[0], pair[1], 0, 8, 2, 10, 4, 12, 6, 14);
+    const Eight t1 = __builtin_shufflevector(pair[0], pair[1], 1, 9, 3, 11, 5, 13, 7, 15);
+    const Eight t2 = __builtin_shufflevector(pair[2], pair[3], 0, 8, 2, 10, 4, 12, 6, 14);
+    const Eight t3 = __builtin_shufflevector(pair[2], pair[3], 1, 9, 3, 11, 5, 13, 7, 15);
+    entries[0][b] = __builtin_shufflevector(t0, t2, 0, 1, 8, 9, 4, 5, 12, 13);
+    entries[2][b] = __builtin_shufflevector(t0, t2, 2, 3, 10, 11, 6, 7, 14, 15);
+    entries[1][b] = __builtin_shufflevector(t1, t3, 0, 1, 8, 9, 4, 5, 12, 13);
+    entries[3][b] = __builtin_shufflevector(t1, t3, 2, 3, 10, 11, 6, 7, 14, 15);
+  }
+  for (int e = 0; e < 4; ++e) out[e] = whole_of(entries[e]);
+}
+
 // Whether every lane of a comparison's mask is true: halves and-ed together
 // (lane by lane, the lanes' extractions were most of G2P's check).
 template <class Mask>

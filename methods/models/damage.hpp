@@ -126,7 +126,12 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
   Real eta() const { return eta_; }
   Real l0() const { return l0_; }
   const ElasticConstants& elastic() const { return c_; }
-  Real degradation(Real d) const { return (1 - d) * (1 - d) * (1 - k_) + k_; }
+  Real degradation(Real d) const { return degradation_of(d); }
+  // The same for T = Real or Lanes (core/lanes.hpp), the same operations per lane.
+  template <class T>
+  MPMTB_INLINE T degradation_of(T d) const {
+    return (Real(1) - d) * (Real(1) - d) * (1 - k_) + k_;
+  }
 
   // The tensile (degraded) and compressive (kept) parts of the energy.
   struct Split {
@@ -201,9 +206,11 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
                                            int lanes, const Lanes (&F)[Dim][Dim], Lanes J,
                                            Lanes logJ, Lanes s, Lanes V0,
                                            Lanes (&out)[Dim][Dim]) const requires(Dim == 3) {
-    const Lanes g = lanes_from(lanes, Real(1), [&](int l) MPMTB_INLINE_LAMBDA {
-      return degradation(damage(particles.state_of(ids[l])));
-    });
+    // g(d) over the register (lane by lane, the formula was a third of the
+    // lanes' instructions before the stress itself).
+    const Lanes g = degradation_of(lanes_from(lanes, Real(0), [&](int l) MPMTB_INLINE_LAMBDA {
+      return particles.state_of(ids[l])[kDamage];
+    }));
     tau_entries_of<Lanes>([&](int i, int j) MPMTB_INLINE_LAMBDA { return F[i][j]; }, J, logJ, s, g,
                           [&](int i, int j, Lanes t) MPMTB_INLINE_LAMBDA { out[i][j] = V0 * t; });
   }
@@ -416,13 +423,26 @@ class Damage final : public ModelBase<Dim, Damage<Dim>> {
       // F by transposes where a whole register's particles are there (core/lanes.hpp;
       // the identity in the lanes past the end, which are not read).
       load_lanes<Dim>(P.F, ids + first, n, F);
-      for (int k = 0; k < L; ++k) {
-        const int p = ids[first + std::min(k, n - 1)];  // the last one again past the end
-        const Real* q = P.state_of(p);
-        d[k] = q[kDamage], lap[k] = q[kLapDamage], diag[k] = q[kLapDiagonal];
+      bool loaded = false;
+      if constexpr (kRecordTransposes) {
+        if (n == L) {  // the state records by transposes (core/lanes.hpp)
+          static_assert(kDamage == 0 && kLapDamage == 2 && kLapDiagonal == 3);
+          Lanes record[4];
+          load_record_lanes(P.state.data(), P.state_size, ids + first, record);
+          d = record[kDamage], lap = record[kLapDamage], diag = record[kLapDiagonal];
+          loaded = true;
+        }
+      }
+      if (!loaded) {
+        for (int k = 0; k < L; ++k) {
+          const int p = ids[first + std::min(k, n - 1)];  // the last one again past the end
+          const Real* q = P.state_of(p);
+          d[k] = q[kDamage], lap[k] = q[kLapDamage], diag[k] = q[kLapDiagonal];
+        }
       }
       const Lanes det = determinant_of<Dim>(F);  // Eigen's, lane by lane
       const auto settled = settled_lanes(F, det, d, lap, diag, dt);
+      if (n == L && all_lanes(settled)) continue;  // most registers, most steps
       for (int k = 0; k < n; ++k) {
         if (!settled[k]) J[m] = det[k], kept[m++] = ids[first + k];
       }

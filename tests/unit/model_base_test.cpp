@@ -216,5 +216,30 @@ TEST(ModelBase, LanesHoldEachParticlesValues) {
   expect_lanes_hold_each_particle<3>();
 }
 
+// A model's state records into registers by transposes (load_record_lanes,
+// where the register is whole multiples of 8 lanes): lane l of entry e holds
+// record ids[l]'s value e, for records longer than the 4 it reads and ids out
+// of order, the last record at the very end of its array.
+TEST(ModelBase, RecordLanesHoldEachParticlesRecord) {
+  if constexpr (!kRecordTransposes) {
+    GTEST_SKIP() << "no record transposes for " << kLanes << " lanes";
+  } else {
+    constexpr long kStride = 5;
+    const int n = 3 * kLanes;
+    std::vector<Real> records((n - 1) * kStride + 4);  // the last record: 4 Reals
+    for (std::size_t i = 0; i < records.size(); ++i) records[i] = Real(0.5) + Real(i);
+    std::vector<int> ids(kLanes);
+    for (int l = 0; l < kLanes; ++l) ids[l] = (7 * l + (l == 0 ? n - 1 : 3)) % n;
+    ASSERT_EQ(ids[0], n - 1);
+    Lanes entries[4];
+    load_record_lanes(records.data(), kStride, ids.data(), entries);
+    for (int l = 0; l < kLanes; ++l) {
+      for (int e = 0; e < 4; ++e) {
+        EXPECT_EQ(entries[e][l], records[ids[l] * kStride + e]) << "lane " << l << ", entry " << e;
+      }
+    }
+  }
+}
+
 }  // namespace model_base_test
 }  // namespace mpmtb
