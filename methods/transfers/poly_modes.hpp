@@ -65,7 +65,15 @@ struct PolyModes {
   // The same from the weights w_a(k) and offsets (x_i - x_p)_a of node k, lane
   // by lane: lanes hold axes, of one particle or of several (keep_group).
   MPMTB_INLINE void build_lanes(const Lanes (&w)[S], const Lanes (&d)[S], Real dx) {
+    if constexpr (S == 3) {
+      build_three(w, d, dx);
+    } else {
+      build_by_gram_schmidt(w, d, dx);
+    }
+  }
+  MPMTB_INLINE void build_by_gram_schmidt(const Lanes (&w)[S], const Lanes (&d)[S], Real dx) {
     inv_dx = 1 / dx;
+    root_norm_ = Lanes{};  // set at n = 1 below (GCC cannot always tell)
     const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
     Lanes u[S], power[S], q[S][S], inv_norm[S];
     for (int k = 0; k < S; ++k) {
@@ -109,6 +117,59 @@ struct PolyModes {
       }
       if (n == 1) root_norm_ = norm_[1] * inv_root;  // sqrt(norm), 0 if dropped
     }
+    d0_ = d[0];
+  }
+
+  // Three nodes (quadratic B-spline, uGIMP): the same modes in closed form, a
+  // few short chains instead of Gram-Schmidt's long one (the 3D quadratic step
+  // builds every particle's modes twice). On three equally spaced nodes the
+  // quadratic mode is the one vector orthogonal under the weights to 1 and u:
+  // e_2(u_k) = (2 / N) c_k / w_k with c = (1, -2, 1), the second difference,
+  // which annihilates every affine function of the u_k, and N = sum_k c_k^2 /
+  // w_k (2 = the second difference of u^2, so e_2 is u^2 less its projections
+  // on 1 and u). Its norm is 4 / N and its unit mode's weighted values are
+  // w_k unit_2(k) = c_k / sqrt(N), which sum to 0 exactly. e_1 = u - mu with mu
+  // = sum_k w_k u_k / sum_k w_k (one Gram-Schmidt pass: the weights sum to 1,
+  // the first moment is small). A zero weight makes N infinite and e_2 dropped;
+  // the tolerances are Gram-Schmidt's, on these norms.
+  MPMTB_INLINE void build_three(const Lanes (&w)[3], const Lanes (&d)[3], Real dx) {
+    inv_dx = 1 / dx;
+    const Lanes tol = 1000 * std::numeric_limits<Real>::epsilon() - Lanes{}, zero{};
+    const Lanes one = 1 - zero;
+    Lanes u[3], u2[3];
+    for (int k = 0; k < 3; ++k) u[k] = d[k] * inv_dx, u2[k] = u[k] * u[k];
+    const Lanes sum_w = (w[0] + w[1]) + w[2];
+    const auto dropped0 = ~(sum_w > tol * sum_w);         // lane masks: NaN is dropped too
+    const Lanes inv_sum = dropped0 ? zero : one / sum_w;  // padding lanes: 0, e_1 = u
+    const Lanes mu = ((w[0] * u[0] + w[1] * u[1]) + w[2] * u[2]) * inv_sum;
+    Lanes e1[3];
+    for (int k = 0; k < 3; ++k) e1[k] = u[k] - mu;
+    const Lanes n1 = (w[0] * e1[0] * e1[0] + w[1] * e1[1] * e1[1]) + w[2] * e1[2] * e1[2];
+    const Lanes m1 = (w[0] * u2[0] + w[1] * u2[1]) + w[2] * u2[2];
+    const auto dropped1 = dropped0 | ~(n1 > tol * m1);
+    Lanes inv_w[3];
+    for (int k = 0; k < 3; ++k) inv_w[k] = one / w[k];
+    const Lanes inv_N = one / ((inv_w[0] + 4 * inv_w[1]) + inv_w[2]);
+    const Lanes n2 = 4 * inv_N;
+    const Lanes m2 = (w[0] * u2[0] * u2[0] + w[1] * u2[1] * u2[1]) + w[2] * u2[2] * u2[2];
+    const auto dropped2 = dropped1 | ~(n2 > tol * m2);
+    norm_[0] = dropped0 ? zero : sum_w;
+    norm_[1] = dropped1 ? zero : n1;
+    norm_[2] = dropped2 ? zero : n2;
+    Lanes inv_root1 = one / n1, inv_root2 = inv_N;
+    axis_sqrt_in_place(inv_root1), axis_sqrt_in_place(inv_root2);
+    inv_root1 = dropped1 ? zero : inv_root1;
+    inv_root2 = dropped2 ? zero : inv_root2;
+    constexpr Real c[3] = {1, -2, 1};
+    for (int k = 0; k < 3; ++k) {
+      e_[0][k] = one, unit_[0][k] = one, wunit_[0][k] = w[k];
+      e_[1][k] = e1[k], unit_[1][k] = e1[k] * inv_root1, wunit_[1][k] = w[k] * unit_[1][k];
+      const Lanes e2 = 2 * c[k] * inv_w[k] * inv_N;
+      e_[2][k] = dropped2 ? zero : e2;
+      unit_[2][k] = dropped2 ? zero : c[k] * inv_w[k] * inv_root2;
+      wunit_[2][k] = c[k] * inv_root2;
+    }
+    root_norm_ = norm_[1] * inv_root1;  // sqrt(norm), 0 if dropped
     d0_ = d[0];
   }
 

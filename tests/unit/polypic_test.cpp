@@ -57,6 +57,65 @@ TEST(PolypicModes, OrthogonalUnderTheWeights) {
   }
 }
 
+// Three nodes per axis (quadratic B-spline, uGIMP): the closed-form modes
+// (PolyModes::build_three) are Gram-Schmidt's to round-off (the quadratic mode
+// is unique up to its scale on three nodes), drop where it drops (a particle
+// half-way between nodes), and stay orthonormal under the weights where an end
+// weight is tiny (an offset of 1e-6 to 1e-14 cells from half-way), where
+// Gram-Schmidt's cancellation is worst.
+template <class Kernel>
+void check_closed_form_modes() {
+  constexpr int S = Kernel::support;
+  static_assert(S == 3);
+  const Real dx = 0.1;
+  const GridGeometry<1> geo(Vec<1>::Zero(), dx, {16});
+  std::vector<Real> xs = {0.35, 0.3, 0.45 - 1e-9, 0.35 + 1e-7};
+  std::mt19937 gen(23);
+  std::uniform_real_distribution<Real> inside(0.3, 0.4);
+  for (int i = 0; i < 200; ++i) xs.push_back(inside(gen));
+  for (const Real tiny : {1e-6, 1e-10, 1e-14}) {
+    xs.push_back(0.35 + tiny * dx), xs.push_back(0.35 - tiny * dx);
+  }
+  int dropped = 0, kept = 0;
+  for (const Real x : xs) {
+    const Stencil<1, Kernel> st(Vec<1>(x), geo);
+    PolyModes<1, S> closed, gs;
+    closed.build(st, dx);
+    gs.build_by_gram_schmidt(st.wk, st.dk, dx);
+    for (int n = 0; n < S; ++n) {
+      EXPECT_EQ(closed.norm(0, n) == 0, gs.norm(0, n) == 0) << "x " << x << ", mode " << n;
+      EXPECT_NEAR(closed.norm(0, n), gs.norm(0, n), 1e-13) << "x " << x << ", mode " << n;
+    }
+    EXPECT_NEAR(closed.root_norm(0), gs.root_norm(0), 1e-13) << "x " << x;
+    (closed.norm(0, 2) == 0 ? dropped : kept) += 1;
+    for (int n = 0; n < S; ++n) {
+      for (int k = 0; k < S; ++k) {
+        // Gram-Schmidt's own error grows as an end weight shrinks.
+        const Real w_end = std::min(st.w(0, 0), st.w(0, 2));
+        const Real tolerance = 1e-13 / std::sqrt(std::max(w_end, Real(1e-8)));
+        EXPECT_NEAR(closed.wunit(0, n, k), gs.wunit(0, n, k), tolerance)
+            << Kernel::name << " x " << x << ", mode " << n << ", node " << k;
+      }
+      // Orthonormal under the weights: sum_k w_k unit_n unit_m = delta_nm.
+      for (int m = 0; m <= n; ++m) {
+        if (closed.norm(0, n) == 0 || closed.norm(0, m) == 0) continue;
+        Real dot = 0;
+        for (int k = 0; k < S; ++k) dot += closed.wunit(0, n, k) * closed.unit(0, m, k);
+        EXPECT_NEAR(dot, n == m ? 1 : 0, 1e-14) << "x " << x << ", modes " << n << ", " << m;
+      }
+    }
+  }
+  EXPECT_GT(kept, 100);
+  if (std::is_same_v<Kernel, QuadraticKernel>) {
+    EXPECT_GE(dropped, 1);  // half-way
+  }
+}
+
+TEST(PolypicModes, ClosedFormOnThreeNodesIsGramSchmidts) {
+  check_closed_form_modes<QuadraticKernel>();
+  check_closed_form_modes<GimpKernel>();
+}
+
 // G particles' modes from one build, their axes side by side in the lanes
 // (PolyModes::keep_group, the pass before P2G: pairs, in 3D in a register twice
 // as wide as one particle's, and fours in 2D), are each particle's own build,
