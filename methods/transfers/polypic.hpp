@@ -18,6 +18,8 @@
 // it to round-off).
 #pragma once
 
+#include <immintrin.h>
+
 #include <algorithm>
 #include <cassert>
 #include <cmath>
@@ -113,7 +115,7 @@ class PolypicPolicy {
 #pragma GCC unroll 64
     for (int r = 0; r < kModes; ++r) {
       if (Modes::higher(r)) {
-        s.c[r] = row(Eigen::Map<const V>(stored));
+        s.c[r] = scaled_row(stored, s.m);
         stored += Dim;
       }
     }
@@ -125,6 +127,31 @@ class PolypicPolicy {
     s.modes.to_nodes(s.c, s.nodes);
     return s;
   }
+  // m v_0 .. m v_{Dim-1} in the p slots of a row, 0 in the others. In 3D with
+  // AVX-512 and three nodes per axis a masked load and a lane rotation (the same
+  // products) instead of a segment's three scalar products and inserts for each
+  // of the 23 higher modes: 3D block, quadratic, 1 thread, 1.029x (10 rounds).
+  // With four nodes (60 higher modes) it measured 0.94x-0.97x: not taken there.
+  MPMTB_INLINE static ScatterRow scaled_row(const Real* v, Real m) {
+#if defined(__AVX512VL__)
+    if constexpr (Dim == 3 && S == 3 && kP == 1 && ScatterRow::K == 1 && ScatterRow::lanes == 4) {
+      using Pack = typename ScatterRow::Pack;
+      Pack x;  // (v_0, v_1, v_2, 0): the lane past the record is not read
+      if constexpr (std::is_same_v<Real, double>) {
+        x = reinterpret_cast<Pack>(_mm256_maskz_loadu_pd(0x7, v));
+      } else {
+        x = reinterpret_cast<Pack>(_mm_maskz_loadu_ps(0x7, v));
+      }
+      ScatterRow r;
+      r.v[0] = __builtin_shufflevector(x, x, 3, 0, 1, 2) * m;
+      return r;
+    }
+#endif
+    RowBuilder<kScatterWidth> r;
+    r.template segment<Dim>(kP) = m * Eigen::Map<const V>(v);
+    return r.row();
+  }
+
   // The reference: the polynomial evaluated at the node, mode by mode.
   void scatter(const Source& s, Real w, const V& grad, const V& d, Real& m_i, V& p_i,
                V& f_i) const {
