@@ -153,7 +153,8 @@ class PolypicPolicy {
   }
 
   // A mode's Dim coefficients from its row of to_modes (a GatherRow) into the
-  // particle's record. In 3D with AVX-512 one masked store from the row as a
+  // particle's record. In 3D with AVX-512 and three or four nodes per axis (the
+  // hat, unmeasured, keeps the copy) one masked store from the row as a
   // register, as P2G's scaled_row loads them: 3D block at 1 thread, quadratic
   // 1.032x and 1.037x (10 rounds each), cubic 1.021x and 1.019x (8 each),
   // cpGIMP 1.00x (6).
